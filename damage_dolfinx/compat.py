@@ -1,0 +1,194 @@
+"""Every DOLFINx-version-specific call of the package, in one place.
+
+The package targets DOLFINx 0.5.2 (Debian 12). Differences with newer releases are handled by
+feature probes (``hasattr``) rather than version strings, so a port to 0.9/0.10 touches this
+file only. Nothing else in the package may call an API listed here directly.
+"""
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import ufl
+import dolfinx
+import dolfinx.fem.petsc  # noqa: F401  (0.7+ no longer imports it implicitly)
+from dolfinx import fem, mesh as dmesh
+from petsc4py import PETSc
+
+# ffcx/dolfinx JIT logs every compilation at INFO on the root logger; keep the user's console clean.
+logging.getLogger().setLevel(logging.WARNING)
+for _name in ("ffcx", "UFL", "dolfinx"):
+    logging.getLogger(_name).setLevel(logging.WARNING)
+
+DOLFINX_VERSION = dolfinx.__version__
+ScalarType = getattr(dolfinx, "default_scalar_type", PETSc.ScalarType)
+
+
+# ---------------------------------------------------------------------------- function spaces
+def function_space(msh, family: str, degree: int, shape: tuple = ()):
+    """Lagrange/DG space with value shape () (scalar), (gdim,) (vector) or (gdim, gdim)."""
+    if hasattr(fem, "functionspace"):  # 0.7+
+        return fem.functionspace(msh, (family, degree, shape) if shape else (family, degree))
+    cell = msh.ufl_cell()
+    if shape == ():
+        return fem.FunctionSpace(msh, (family, degree))
+    if len(shape) == 1:
+        return fem.FunctionSpace(msh, ufl.VectorElement(family, cell, degree, dim=shape[0]))
+    return fem.FunctionSpace(msh, ufl.TensorElement(family, cell, degree, shape=shape))
+
+
+def scalar_p1(msh):
+    return function_space(msh, "Lagrange", 1)
+
+
+def vector_p1(msh):
+    return function_space(msh, "Lagrange", 1, (2,))
+
+
+def scalar_dg0(msh):
+    return function_space(msh, "DG", 0)
+
+
+def tensor_dg0(msh):
+    return function_space(msh, "DG", 0, (2, 2))
+
+
+# ---------------------------------------------------------------------------- vectors
+def petsc_vec(u: fem.Function) -> PETSc.Vec:
+    """The PETSc vector that wraps a Function's dof array (ghosted)."""
+    return u.x.petsc_vec if hasattr(u.x, "petsc_vec") else u.vector
+
+
+def create_vector(L_form) -> PETSc.Vec:
+    try:
+        return fem.petsc.create_vector(L_form)
+    except TypeError:  # 0.10: takes function spaces
+        return fem.petsc.create_vector(fem.extract_function_spaces(L_form))
+
+
+def create_matrix(a_form) -> PETSc.Mat:
+    return fem.petsc.create_matrix(a_form)
+
+
+def assemble_vector(b, L_form):
+    fem.petsc.assemble_vector(b, L_form)
+
+
+def assemble_matrix(A, a_form, bcs):
+    fem.petsc.assemble_matrix(A, a_form, bcs=bcs)
+
+
+def apply_lifting(b, a_form, bcs, x0=None, scale=1.0):
+    """b -= scale * A (g - x0) on the columns of Dirichlet dofs ('scale' <= 0.8, 'alpha' >= 0.9)."""
+    fem.petsc.apply_lifting(b, [a_form], [bcs], [] if x0 is None else [x0], scale)
+
+
+def set_bc(b, bcs, x0=None, scale=1.0):
+    fem.petsc.set_bc(b, bcs, x0, scale)
+
+
+def form(ufl_form, jit_options=None):
+    return fem.form(ufl_form, jit_params=jit_options or {}) if jit_options else fem.form(ufl_form)
+
+
+def assemble_scalar(ufl_or_form, comm) -> float:
+    """Globally summed integral of a scalar form (compiled or UFL)."""
+    f = ufl_or_form if isinstance(ufl_or_form, fem.FormMetaClass) else fem.form(ufl_or_form)
+    return comm.allreduce(fem.assemble_scalar(f), op=_mpi_sum())
+
+
+def _mpi_sum():
+    from mpi4py import MPI
+    return MPI.SUM
+
+
+# ---------------------------------------------------------------------------- interpolation
+def interpolation_points(V):
+    pts = V.element.interpolation_points
+    return pts() if callable(pts) else pts
+
+
+def expression(expr, V):
+    """A compiled fem.Expression of ``expr`` at the interpolation points of V."""
+    return fem.Expression(expr, interpolation_points(V))
+
+
+def interpolate(u: fem.Function, source):
+    """u <- interpolant of a Python callable, a fem.Expression or a Function on the same mesh."""
+    u.interpolate(source)
+    u.x.scatter_forward()
+
+
+# ---------------------------------------------------------------------------- meshes
+def create_rectangle(comm, p0, p1, n, diagonal: str = "right"):
+    return dmesh.create_rectangle(comm, [np.asarray(p0, float), np.asarray(p1, float)], list(n),
+                                  dmesh.CellType.triangle,
+                                  diagonal=getattr(dmesh.DiagonalType, diagonal))
+
+
+def create_submesh(msh, dim, entities):
+    """Submesh of the given entities; returns the mesh only (maps differ between versions)."""
+    out = dmesh.create_submesh(msh, dim, entities)
+    return out[0]
+
+
+def locate_entities_boundary(msh, dim, marker):
+    msh.topology.create_connectivity(dim, msh.topology.dim)
+    return dmesh.locate_entities_boundary(msh, dim, marker)
+
+
+def locate_entities(msh, dim, marker):
+    return dmesh.locate_entities(msh, dim, marker)
+
+
+def meshtags(msh, dim, entities, values):
+    order = np.argsort(entities)
+    return dmesh.meshtags(msh, dim, np.asarray(entities, np.int32)[order],
+                          np.asarray(values, np.int32)[order])
+
+
+def cell_midpoints(msh):
+    """Midpoints of all local cells (owned and ghost), shape (num_cells, 3)."""
+    tdim = msh.topology.dim
+    imap = msh.topology.index_map(tdim)
+    cells = np.arange(imap.size_local + imap.num_ghosts, dtype=np.int32)
+    return dmesh.compute_midpoints(msh, tdim, cells)
+
+
+def num_owned_cells(msh) -> int:
+    return msh.topology.index_map(msh.topology.dim).size_local
+
+
+def cell_vertex_coords(msh):
+    """(n_owned_cells, nverts, 2) coordinates of the owned cells' geometry nodes (P1 meshes)."""
+    nc = num_owned_cells(msh)
+    dm = msh.geometry.dofmap
+    conn = dm.array.reshape(-1, dm.links(0).size)[:nc] if hasattr(dm, "array") else dm[:nc]
+    return msh.geometry.x[conn][:, :, :2]
+
+
+def cell_dofs(V):
+    """(n_owned_cells, ndofs_per_cell) local dof indices (block index for vector spaces)."""
+    nc = num_owned_cells(V.mesh)
+    dl = V.dofmap.list
+    arr = dl.array.reshape(-1, dl.links(0).size) if hasattr(dl, "array") else dl
+    return arr[:nc]
+
+
+def model_to_mesh(model, comm, rank=0, gdim=2):
+    """gmsh model -> (mesh, cell_tags, facet_tags), the model living on ``rank``."""
+    try:
+        from dolfinx.io import gmshio
+        out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    except ImportError:  # 0.10
+        from dolfinx.io import gmsh as gmshio
+        out = gmshio.model_to_mesh(model, comm, rank, gdim=gdim)
+    if hasattr(out, "mesh"):
+        return out.mesh, out.cell_tags, out.facet_tags
+    return out
+
+
+# ---------------------------------------------------------------------------- output
+def xdmf_file(comm, path, mode):
+    from dolfinx.io import XDMFFile
+    return XDMFFile(comm, str(path), mode)

@@ -1,0 +1,100 @@
+"""Damage source functions (1.3), (1.4) and the discrete damage step (PROBLEMS.md 1.3-1.4).
+
+The step is either the linear PDE solve (1.5) (Sections 2.1, 2.3) with a matrix factorised once,
+or the obstacle problem over K^h = {zeta_star <= zeta <= 1} solved by PETSc SNES
+``vinewtonrsls`` with nodal bounds (Sections 2.2, 2.4, 3.x). Both use the consistent mass matrix.
+"""
+from __future__ import annotations
+
+import ufl
+from dolfinx import fem
+from petsc4py import PETSc
+
+from . import compat
+from .constitutive import Psi_q, eta_star, split_norms_sq
+from .forms.damage import damage_step_forms
+from .solvers import DIRECT, LinearSolver, SNESSolver, SolveContext
+
+
+def phi_A(e, z, p):
+    """Variant A (1.3): lam_D (1 - eta_*(z))/eta_*(z) - 0.5 lam_u Psi_q(e) - lam_w."""
+    ez = eta_star(z, p.zeta_star)
+    return p.lam_D * (1.0 - ez) / ez - 0.5 * p.lam_u * Psi_q(e, p.q_star) - p.lam_w
+
+
+def phi_B(e, z, p):
+    """Variant B (1.4): lam_D (1 - z)/eta_*(z) - 0.5 lam_u^- Psi_q(e^-) - 0.5 lam_u^+ Psi_q(e^+) - lam_w.
+
+    Psi_q of the split parts is min(|e^+-|^2, q_star), from the closed-form 2-D eigenvalues.
+    """
+    pos_sq, neg_sq = split_norms_sq(e)
+    return (p.lam_D * (1.0 - z) / eta_star(z, p.zeta_star)
+            - 0.5 * p.lam_u_minus * ufl.min_value(neg_sq, p.q_star)
+            - 0.5 * p.lam_u_plus * ufl.min_value(pos_sq, p.q_star)
+            - p.lam_w)
+
+
+def source(e, z, p):
+    """The damage source phi(eps, zeta) of the variant selected in ``p`` (A or B)."""
+    return phi_A(e, z, p) if p.variant == "A" else phi_B(e, z, p)
+
+
+#: SNES defaults of the obstacle step (PROBLEMS.md 1.4); override with -damage_snes_* options.
+OBSTACLE_DEFAULTS = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_atol": 1e-12,
+                     "snes_stol": 0.0, "snes_max_it": 50, "snes_linesearch_type": "basic", **DIRECT}
+
+
+class DamageStep:
+    """zeta_n from b(zeta_n, xi) = l(xi) (PDE) or the VI b(zeta_n, xi - zeta_n) >= l(xi - zeta_n).
+
+    ``zeta`` receives the new damage; ``zeta_old`` and ``phi_old`` (a UFL expression of the
+    step n-1 state) enter the right-hand side. The matrix b is constant for a fixed k: it is
+    assembled (and, for the PDE form, factorised) once.
+    """
+
+    def __init__(self, zeta: fem.Function, zeta_old: fem.Function, phi_old, k, kappa,
+                 context: SolveContext, obstacle: bool, zeta_star: float = 0.01,
+                 prefix: str = "damage_"):
+        V = zeta.function_space
+        a, L = damage_step_forms(ufl.TrialFunction(V), ufl.TestFunction(V), zeta_old, phi_old,
+                                 k, kappa)
+        self.zeta, self.zeta_old, self.obstacle = zeta, zeta_old, obstacle
+        if not obstacle:
+            self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True)
+            return
+        self.a, self.L = compat.form(a), compat.form(L)
+        self.A = compat.create_matrix(self.a)
+        compat.assemble_matrix(self.A, self.a, [])
+        self.A.assemble()
+        self.b = compat.create_vector(self.L)
+        self.lower, self.upper = self.b.duplicate(), self.b.duplicate()
+        self.lower.set(zeta_star)
+        self.upper.set(1.0)
+        self.snes = SNESSolver(V.mesh.comm, prefix, context, self._residual, self._jacobian,
+                               self.b.duplicate(), self.A, OBSTACLE_DEFAULTS,
+                               bounds=(self.lower, self.upper))
+
+    def _residual(self, x, f):
+        """F(z) = B z - l: the damage step is affine, so no re-assembly inside Newton."""
+        self.A.mult(x, f)
+        f.axpy(-1.0, self.b)
+
+    def _jacobian(self, x, J):
+        """The Jacobian is the constant matrix B, assembled once."""
+
+    def solve(self) -> int:
+        """Compute zeta_n; returns iterations (KSP for the PDE form, Newton for the VI)."""
+        if not self.obstacle:
+            return self.linear.solve(self.zeta)
+        with self.b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(self.b, self.L)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.zeta.x.array[:] = self.zeta_old.x.array
+        its = self.snes.solve(compat.petsc_vec(self.zeta))
+        self.zeta.x.scatter_forward()
+        return its
+
+    @property
+    def iterations(self) -> int:
+        return self.linear.iterations if not self.obstacle else self.snes.iterations

@@ -1,0 +1,177 @@
+"""Thin petsc4py wrappers: linear (KSP) and nonlinear/bound-constrained (SNES) solvers.
+
+Every solver has a PETSc options prefix (``damage_``, ``mech_`` ...): package defaults are put in
+the options database only where the user has not set the option, so ``-mech_ksp_type cg
+-mech_pc_type gamg`` on the command line wins. Every solve checks the converged reason and
+raises :class:`ConvergenceError` naming the example, the step, the time and the residual.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from petsc4py import PETSc
+
+from . import compat
+
+
+class ConvergenceError(RuntimeError):
+    """A PETSc solver did not converge; the message names example, step, time and residual."""
+
+
+@dataclass
+class SolveContext:
+    """Where a solve happens; shared by the solvers of one run and updated by the time loop."""
+    example: str = "?"
+    step: int = 0
+    t: float = 0.0
+
+
+def _reason_name(enum, reason: int) -> str:
+    for name in dir(enum):
+        if not name.startswith("_") and getattr(enum, name) == reason:
+            return name
+    return str(reason)
+
+
+def set_default_options(prefix: str, defaults: dict):
+    """Put ``defaults`` under ``prefix`` in the PETSc options database unless already set."""
+    opts = PETSc.Options()
+    for key, value in defaults.items():
+        if not opts.hasName(prefix + key):
+            opts[prefix + key] = value
+
+
+#: direct solve, factorisation reused while the matrix is unchanged
+DIRECT = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+
+
+class LinearSolver:
+    """Solve a(u, w) = L(w) with Dirichlet conditions by a PETSc KSP.
+
+    With ``constant_matrix=True`` the matrix is assembled and factorised once; otherwise it is
+    re-assembled in place (same sparsity, so a direct solver redoes only the numeric
+    factorisation, the symbolic analysis is reused).
+    """
+
+    def __init__(self, a, L, bcs, prefix: str, context: SolveContext, constant_matrix=False,
+                 defaults=None):
+        self.a, self.L, self.bcs = compat.form(a), compat.form(L), list(bcs)
+        self.prefix, self.context, self.constant_matrix = prefix, context, constant_matrix
+        self.A = compat.create_matrix(self.a)
+        self.b = compat.create_vector(self.L)
+        self._assembled = False
+        set_default_options(prefix, DIRECT if defaults is None else defaults)
+        self.ksp = PETSc.KSP().create(self.A.getComm())
+        self.ksp.setOptionsPrefix(prefix)
+        self.ksp.setOperators(self.A)
+        self.ksp.setFromOptions()
+        self.iterations = 0
+        self.solves = 0
+
+    def assemble_matrix(self):
+        self.A.zeroEntries()
+        compat.assemble_matrix(self.A, self.a, self.bcs)
+        self.A.assemble()
+        self._assembled = True
+
+    def assemble_rhs(self):
+        with self.b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(self.b, self.L)
+        compat.apply_lifting(self.b, self.a, self.bcs)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        compat.set_bc(self.b, self.bcs)
+
+    def solve(self, u):
+        """Solve into the Function ``u``; returns the KSP iteration count."""
+        if not (self.constant_matrix and self._assembled):
+            self.assemble_matrix()
+        self.assemble_rhs()
+        x = compat.petsc_vec(u)
+        self.ksp.solve(self.b, x)
+        reason = self.ksp.getConvergedReason()
+        if reason < 0:
+            r = self.b.duplicate()
+            self.A.mult(x, r)
+            r.aypx(-1.0, self.b)
+            raise ConvergenceError(
+                f"{self.prefix}ksp did not converge ({_reason_name(PETSc.KSP.ConvergedReason, reason)}) "
+                f"in example {self.context.example}, step {self.context.step}, t = {self.context.t:.6g}, "
+                f"residual {r.norm():.3e}")
+        u.x.scatter_forward()
+        its = self.ksp.getIterationNumber()
+        self.iterations += its
+        self.solves += 1
+        return its
+
+
+class SNESSolver:
+    """A PETSc SNES on callbacks F(x, b) and J(x, A) with an options prefix and optional bounds.
+
+    The iterate is a private copy of the unknown's vector (line searches must not overwrite the
+    state the callbacks read, dolfinx PR #3507); bounds ``(lb, ub)`` are passed by reference, so
+    in-place changes take effect at the next solve.
+    """
+
+    def __init__(self, comm, prefix: str, context: SolveContext, residual, jacobian, b, A,
+                 defaults: dict, bounds=None):
+        self.prefix, self.context = prefix, context
+        self._residual_cb, self._jacobian_cb = residual, jacobian
+        set_default_options(prefix, defaults)
+        self.snes = PETSc.SNES().create(comm)
+        self.snes.setOptionsPrefix(prefix)
+        self.snes.setFunction(lambda snes, x, f: residual(x, f), b)
+        self.snes.setJacobian(lambda snes, x, J, P: jacobian(x, J), A)
+        if bounds is not None:
+            self.snes.setVariableBounds(*bounds)
+        self.snes.setFromOptions()
+        self.iterations = 0
+        self.linear_iterations = 0
+        self.solves = 0
+
+    def solve(self, x_state: PETSc.Vec) -> int:
+        """Solve starting from ``x_state`` and write the solution back; returns Newton iterations."""
+        x = x_state.copy()
+        self.snes.solve(None, x)
+        reason = self.snes.getConvergedReason()
+        if reason <= 0:
+            raise ConvergenceError(
+                f"{self.prefix}snes did not converge ({_reason_name(PETSc.SNES.ConvergedReason, reason)}) "
+                f"in example {self.context.example}, step {self.context.step}, t = {self.context.t:.6g}, "
+                f"residual {self.snes.getFunctionNorm():.3e} after {self.snes.getIterationNumber()} iterations")
+        x.copy(x_state)
+        x_state.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        x.destroy()
+        its = self.snes.getIterationNumber()
+        self.iterations += its
+        self.linear_iterations += self.snes.getLinearSolveIterations()
+        self.solves += 1
+        return its
+
+
+def form_callbacks(F, J, u, bcs):
+    """(residual, jacobian, b, A) callbacks for SNESSolver from UFL forms F(u; w), J = dF/du.
+
+    The pattern of PROBLEMS.md / fenicsx-patterns section 2: the SNES iterate is copied into
+    ``u`` before assembly, Dirichlet rows are set to x - g so that the BC holds at convergence.
+    """
+    F_form, J_form = compat.form(F), compat.form(J)
+    u_vec = compat.petsc_vec(u)
+
+    def residual(x, b):
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        x.copy(u_vec)
+        u.x.scatter_forward()
+        with b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(b, F_form)
+        compat.apply_lifting(b, J_form, bcs, x, -1.0)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        compat.set_bc(b, bcs, x, -1.0)
+
+    def jacobian(x, A):
+        A.zeroEntries()
+        compat.assemble_matrix(A, J_form, bcs)
+        A.assemble()
+
+    return residual, jacobian, compat.create_vector(F_form), compat.create_matrix(J_form)

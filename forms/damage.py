@@ -1,0 +1,18 @@
+"""Discrete damage step shared by all seven schemes (PROBLEMS.md 1.4).
+
+b(z, xi) = (z, xi) + k kappa (grad z, grad xi),  l(xi) = (zeta_old, xi) + k (phi_old, xi):
+the PDE form (1.5) solves b(zeta_n, .) = l; the obstacle form solves the VI over
+K^h = {zeta_star <= xi <= 1}.
+"""
+import ufl
+
+#: quadrature degree of the non-polynomial damage source (G38)
+SOURCE_DEGREE = 2
+
+
+def damage_step_forms(zeta, xi, zeta_old, phi_old, k, kappa):
+    """(a, L) of the implicit damage step: zeta and xi are trial/test functions of B^h."""
+    dx = ufl.dx
+    a = zeta * xi * dx + k * kappa * ufl.inner(ufl.grad(zeta), ufl.grad(xi)) * dx
+    L = zeta_old * xi * dx + k * phi_old * xi * dx(metadata={"quadrature_degree": SOURCE_DEGREE})
+    return a, L

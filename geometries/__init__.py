@@ -1,0 +1,41 @@
+"""Geometries of the thesis examples. Each builder returns a :class:`Geometry` whose facet tags
+mark Gamma_D, Gamma_N and Gamma_C with the tags below."""
+from dataclasses import dataclass
+from typing import Optional
+
+GAMMA_D, GAMMA_N, GAMMA_C = 1, 2, 3
+
+
+@dataclass
+class StructuredGrid:
+    """The n_x x n_y grid (diagonals 'right') a structured mesh was cut from; meshes on grids
+    with nested spacing are nested, which the convergence studies use."""
+    x0: float
+    y0: float
+    Lx: float
+    Ly: float
+    nx: int
+    ny: int
+
+
+@dataclass
+class Geometry:
+    mesh: object
+    facet_tags: object
+    h: float                           # characteristic (maximal) cell diameter
+    grid: Optional[StructuredGrid] = None
+    description: str = ""
+
+
+_gmsh_ready = False
+
+
+def gmsh_session():
+    """Initialise gmsh once per process (gmsh 4.8 has no isInitialized) and silence it."""
+    global _gmsh_ready
+    import gmsh
+    if not _gmsh_ready:
+        gmsh.initialize()
+        gmsh.option.setNumber("General.Terminal", 0)
+        _gmsh_ready = True
+    return gmsh
