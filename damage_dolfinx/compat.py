@@ -15,10 +15,18 @@ import dolfinx.fem.petsc  # noqa: F401  (0.7+ no longer imports it implicitly)
 from dolfinx import fem, mesh as dmesh
 from petsc4py import PETSc
 
-# ffcx/dolfinx JIT logs every compilation at INFO on the root logger; keep the user's console clean.
-logging.getLogger().setLevel(logging.WARNING)
-for _name in ("ffcx", "UFL", "dolfinx"):
-    logging.getLogger(_name).setLevel(logging.WARNING)
+import ffcx  # noqa: E402,F401  (installs a root log handler at import)
+
+
+class _WarningsOnly(logging.Filter):
+    def filter(self, record):
+        return record.levelno >= logging.WARNING
+
+
+# The JIT's C compilation (setuptools) logs every build at INFO on the root logger, and
+# setuptools resets the root level while doing so: filter at the handlers instead.
+for _handler in logging.getLogger().handlers:
+    _handler.addFilter(_WarningsOnly())
 
 DOLFINX_VERSION = dolfinx.__version__
 ScalarType = getattr(dolfinx, "default_scalar_type", PETSc.ScalarType)
@@ -192,3 +200,13 @@ def model_to_mesh(model, comm, rank=0, gdim=2):
 def xdmf_file(comm, path, mode):
     from dolfinx.io import XDMFFile
     return XDMFFile(comm, str(path), mode)
+
+
+def read_msh(comm, path, rank=0, gdim=2):
+    """.msh file -> (mesh, cell_tags, facet_tags)."""
+    try:
+        from dolfinx.io import gmshio
+    except ImportError:
+        from dolfinx.io import gmsh as gmshio
+    out = gmshio.read_from_msh(path, comm, rank, gdim=gdim)
+    return (out.mesh, out.cell_tags, out.facet_tags) if hasattr(out, "mesh") else out

@@ -7,6 +7,8 @@ raises :class:`ConvergenceError` naming the example, the step, the time and the 
 """
 from __future__ import annotations
 
+import time
+from collections import defaultdict
 from dataclasses import dataclass
 
 from petsc4py import PETSc
@@ -67,20 +69,25 @@ class LinearSolver:
         self.ksp.setFromOptions()
         self.iterations = 0
         self.solves = 0
+        self.timings = defaultdict(float)  # seconds: assemble_matrix, assemble_rhs, solve
 
     def assemble_matrix(self):
+        start = time.perf_counter()
         self.A.zeroEntries()
         compat.assemble_matrix(self.A, self.a, self.bcs)
         self.A.assemble()
         self._assembled = True
+        self.timings["assemble_matrix"] += time.perf_counter() - start
 
     def assemble_rhs(self):
+        start = time.perf_counter()
         with self.b.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(self.b, self.L)
         compat.apply_lifting(self.b, self.a, self.bcs)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         compat.set_bc(self.b, self.bcs)
+        self.timings["assemble_rhs"] += time.perf_counter() - start
 
     def solve(self, u):
         """Solve into the Function ``u``; returns the KSP iteration count."""
@@ -88,7 +95,9 @@ class LinearSolver:
             self.assemble_matrix()
         self.assemble_rhs()
         x = compat.petsc_vec(u)
+        start = time.perf_counter()
         self.ksp.solve(self.b, x)
+        self.timings["solve"] += time.perf_counter() - start
         reason = self.ksp.getConvergedReason()
         if reason < 0:
             r = self.b.duplicate()

@@ -39,3 +39,10 @@ def gmsh_session():
         gmsh.option.setNumber("General.Terminal", 0)
         _gmsh_ready = True
     return gmsh
+
+
+def read_msh(comm, path) -> Geometry:
+    """A gmsh .msh file whose physical curve tags follow GAMMA_D/GAMMA_N/GAMMA_C."""
+    from damage_dolfinx import compat
+    msh, _, facet_tags = compat.read_msh(comm, str(path))
+    return Geometry(msh, facet_tags, h=float("nan"), description=f"gmsh file {path}")

@@ -1,0 +1,125 @@
+"""Command line: ``damage-dolfinx list | run ID | converge ID`` (works unchanged under mpirun).
+
+Options the parser does not know (``-mech_ksp_type cg``, ``-damage_snes_monitor``) go to the
+PETSc options database. User errors print one line on rank 0 and exit with status 2; a solver
+that does not converge exits with status 3 after writing what was finished.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from mpi4py import MPI
+
+
+def _parser():
+    p = argparse.ArgumentParser(prog="damage-dolfinx", allow_abbrev=False,
+                                description="Damage models of Campo (2007) with DOLFINx.")
+    sub = p.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="list the example ids")
+
+    def common(sp):
+        sp.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`)")
+        sp.add_argument("--T", type=float, help="final time")
+        sp.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="override a model parameter, e.g. --set kappa=0.01 (repeatable)")
+        sp.add_argument("--out", required=True, help="output folder")
+        sp.add_argument("--quiet", action="store_true", help="no progress lines")
+
+    run = sub.add_parser("run", help="run one example", allow_abbrev=False)
+    common(run)
+    run.add_argument("--n", type=int, help="cells per side (structured meshes)")
+    run.add_argument("--h", type=float, help="element size (gmsh meshes)")
+    run.add_argument("--k", type=float, help="time step")
+    run.add_argument("--mesh", help="gmsh .msh file replacing the built-in geometry")
+    run.add_argument("--write-every", type=int, help="XDMF output every N steps (default N/20)")
+    run.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+
+    conv = sub.add_parser("converge", help="convergence study against a fine reference",
+                          allow_abbrev=False)
+    common(conv)
+    conv.add_argument("--ref-n", type=int, help="reference mesh (cells per side)")
+    conv.add_argument("--ref-k", type=float, help="reference time step")
+    conv.add_argument("--n", type=int, nargs="+", help="coarse meshes")
+    conv.add_argument("--k", type=float, nargs="+", help="coarse time steps")
+    return p
+
+
+def _petsc_options(tokens):
+    """Put '-name [value]' tokens into the PETSc options database; returns unparsed leftovers."""
+    from petsc4py import PETSc
+    opts, leftovers, i = PETSc.Options(), [], 0
+    while i < len(tokens):
+        tok = tokens[i]
+        if tok.startswith("-") and not tok.startswith("--") and len(tok) > 1:
+            value = tokens[i + 1] if i + 1 < len(tokens) and not _is_option(tokens[i + 1]) else None
+            opts[tok[1:]] = value if value is not None else ""
+            i += 2 if value is not None else 1
+        else:
+            leftovers.append(tok)
+            i += 1
+    return leftovers
+
+
+def _is_option(tok):
+    if not tok.startswith("-"):
+        return False
+    try:
+        float(tok)
+        return False
+    except ValueError:
+        return True
+
+
+def _overrides(pairs):
+    from .parameters import InputError
+    out = {}
+    for pair in pairs:
+        if "=" not in pair:
+            raise InputError(f"--set expects NAME=VALUE, got {pair!r}")
+        name, value = pair.split("=", 1)
+        out[name.strip()] = value.strip()
+    return out
+
+
+def main(argv=None):
+    comm = MPI.COMM_WORLD
+    args, extra = _parser().parse_known_args(argv)
+    from .parameters import InputError
+    from .solvers import ConvergenceError
+    try:
+        leftovers = _petsc_options(extra)
+        if leftovers:
+            raise InputError(f"unrecognised arguments: {' '.join(leftovers)}")
+        if args.command == "list":
+            from . import examples
+            if comm.rank == 0:
+                for ex in examples.catalogue().values():
+                    print(f"{ex.id:10s} [Section {ex.section}] {ex.title}")
+            return 0
+        if args.command == "run":
+            from . import runner
+            runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
+                       overrides=_overrides(args.set), mesh_file=args.mesh,
+                       write_every=args.write_every, progress=not args.quiet,
+                       figures=not args.no_figures)
+            return 0
+        if args.command == "converge":
+            from . import convergence
+            convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
+                              ns=args.n, ks=args.k, T=args.T, overrides=_overrides(args.set),
+                              progress=not args.quiet)
+            return 0
+    except InputError as exc:
+        if comm.rank == 0:
+            print(f"damage-dolfinx: error: {exc}", file=sys.stderr, flush=True)
+        return 2
+    except ConvergenceError as exc:
+        if comm.rank == 0:
+            print(f"damage-dolfinx: solver failure: {exc}", file=sys.stderr, flush=True)
+        return 3
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

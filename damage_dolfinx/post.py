@@ -1,0 +1,150 @@
+"""Post-processing: coarse-to-fine transfer on nested structured meshes (errors against a
+reference solution, in parallel) and matplotlib figures of fields on the deformed configuration.
+"""
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+
+from . import compat
+from .constitutive import eps
+
+
+# ---------------------------------------------------------------------------- nested transfer
+class NestedTransfer:
+    """Exact transfer of a P1 field from a coarse structured mesh to a nested fine mesh.
+
+    Both meshes are cut from grids of the same rectangle with diagonals 'right' (the square
+    [i, i+1] x [j, j+1] is split along (i, j)-(i+1, j+1)); the coarse P1 interpolant is then
+    linear on every fine cell, so evaluating it at the fine dofs is exact. The coarse nodal
+    values are gathered into grid order on every rank (coarse meshes are small), the fine dofs
+    are evaluated with precomputed barycentric weights: no point search, any partition.
+    """
+
+    def __init__(self, V_coarse, V_fine, grid):
+        self.grid, self.comm = grid, V_coarse.mesh.comm
+        self.Vc, self.Vf = V_coarse, V_fine
+        self.bs = V_coarse.dofmap.index_map_bs
+        hx, hy = grid.Lx / grid.nx, grid.Ly / grid.ny
+        n_owned = V_coarse.dofmap.index_map.size_local
+        xc = V_coarse.tabulate_dof_coordinates()[:n_owned]
+        i = np.rint((xc[:, 0] - grid.x0) / hx).astype(np.int64)
+        j = np.rint((xc[:, 1] - grid.y0) / hy).astype(np.int64)
+        self._coarse_owned = n_owned
+        self._coarse_grid_index = j * (grid.nx + 1) + i
+        xf = V_fine.tabulate_dof_coordinates()
+        s = (xf[:, 0] - grid.x0) / hx
+        t = (xf[:, 1] - grid.y0) / hy
+        ci = np.clip(np.floor(s + 1e-9), 0, grid.nx - 1)
+        cj = np.clip(np.floor(t + 1e-9), 0, grid.ny - 1)
+        s, t = np.clip(s - ci, 0.0, 1.0), np.clip(t - cj, 0.0, 1.0)
+        ci, cj = ci.astype(np.int64), cj.astype(np.int64)
+        node = lambda di, dj: (cj + dj) * (grid.nx + 1) + (ci + di)  # noqa: E731
+        lower = s >= t  # triangle (0,0),(1,0),(1,1) of the cell
+        self.nodes = np.stack([node(0, 0), np.where(lower, node(1, 0), node(0, 1)), node(1, 1)], 1)
+        self.weights = np.stack([np.where(lower, 1 - s, 1 - t), np.where(lower, s - t, t - s),
+                                 np.where(lower, t, s)], 1)
+
+    def __call__(self, u_coarse, u_fine):
+        """u_fine <- coarse P1 field u_coarse evaluated at the fine dofs (all local dofs)."""
+        vals = u_coarse.x.array.reshape(-1, self.bs)[:self._coarse_owned]
+        idx_all = self.comm.allgather(self._coarse_grid_index)
+        val_all = self.comm.allgather(vals)
+        g = self.grid
+        on_grid = np.zeros(((g.nx + 1) * (g.ny + 1), self.bs))  # nodes in holes stay 0 (weight 0)
+        on_grid[np.concatenate(idx_all)] = np.concatenate(val_all)
+        fine = np.einsum("nk,nkc->nc", self.weights, on_grid[self.nodes])
+        u_fine.x.array[:] = fine.reshape(-1)
+
+
+class ErrorNorms:
+    """||u_ref - I u_h||_V = ||eps(.)||_L2 and ||zeta_ref - I zeta_h||_L2 on the fine mesh."""
+
+    def __init__(self, u_ref, zeta_ref):
+        from dolfinx import fem
+        self.u_ref, self.zeta_ref = u_ref, zeta_ref
+        self.e_u = fem.Function(u_ref.function_space)
+        self.e_z = fem.Function(zeta_ref.function_space)
+        self.comm = u_ref.function_space.mesh.comm
+        self._V_form = compat.form(ufl.inner(eps(self.e_u), eps(self.e_u)) * ufl.dx)
+        self._Y_form = compat.form(self.e_z * self.e_z * ufl.dx)
+
+    def __call__(self, u_interp, zeta_interp):
+        """(V error of u, L2 error of zeta) given the coarse fields transferred to the fine mesh."""
+        self.e_u.x.array[:] = self.u_ref.x.array - u_interp.x.array
+        self.e_z.x.array[:] = self.zeta_ref.x.array - zeta_interp.x.array
+        eu = np.sqrt(abs(compat.assemble_scalar(self._V_form, self.comm)))
+        ez = np.sqrt(abs(compat.assemble_scalar(self._Y_form, self.comm)))
+        return eu, ez
+
+
+# ---------------------------------------------------------------------------- figures
+def gather_cells(u_disp, field, amplification: float = 0.0):
+    """On rank 0: deformed triangle coordinates (nc, 3, 2) and values of ``field`` (P1 -> (nc, 3),
+    DG0 -> (nc,)) for all owned cells; None on other ranks."""
+    msh = field.function_space.mesh
+    xy = compat.cell_vertex_coords(msh).copy()
+    if u_disp is not None and amplification:
+        cd = compat.cell_dofs(u_disp.function_space)
+        xy += amplification * u_disp.x.array.reshape(-1, 2)[cd]
+    values = field.x.array[compat.cell_dofs(field.function_space)]
+    values = values[:, 0] if values.shape[1] == 1 else values
+    xy_all, val_all = msh.comm.gather(xy, root=0), msh.comm.gather(values, root=0)
+    if msh.comm.rank != 0:
+        return None
+    return np.concatenate(xy_all), np.concatenate(val_all)
+
+
+def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None):
+    """One PNG with a panel per (Function, label) in ``fields``, on the configuration
+    x + amplification * u (PROBLEMS.md 1.9); collective, rank 0 draws."""
+    gathered = [(gather_cells(u_disp, f, amplification), label) for f, label in fields]
+    ref = gather_cells(None, fields[0][0], 0.0) if outline else None
+    if MPI.COMM_WORLD.rank != 0 or gathered[0][0] is None:
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.tri as mtri
+
+    fig, axes = plt.subplots(1, len(gathered), figsize=(5.6 * len(gathered), 4.8), squeeze=False)
+    for ax, ((xy, vals), label) in zip(axes[0], gathered):
+        pts = xy.reshape(-1, 2)
+        tri = mtri.Triangulation(pts[:, 0], pts[:, 1], np.arange(pts.shape[0]).reshape(-1, 3))
+        if vals.ndim == 2:
+            im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap="viridis")
+        else:
+            im = ax.tripcolor(tri, facecolors=vals, cmap="viridis")
+        if ref is not None:
+            _draw_outline(ax, ref[0])
+        ax.set_aspect("equal")
+        ax.set_title(label)
+        ax.set_xlabel("x1 [m]")
+        ax.set_ylabel("x2 [m]")
+        fig.colorbar(im, ax=ax, shrink=0.85)
+    suffix = f"  (displacements x{amplification:g})" if amplification not in (0, 1) else ""
+    fig.suptitle(title + suffix)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def _draw_outline(ax, xy):
+    """Boundary edges (edges belonging to one triangle only) of the undeformed mesh."""
+    edges = np.concatenate([xy[:, [0, 1]], xy[:, [1, 2]], xy[:, [2, 0]]])
+    a, b = np.round(edges[:, 0], 9), np.round(edges[:, 1], 9)
+    swap = ((a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1])))[:, None]
+    key = np.hstack([np.where(swap, b, a), np.where(swap, a, b)])
+    _, idx, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    for e in edges[idx[counts == 1]]:
+        ax.plot(e[:, 0], e[:, 1], color="0.4", lw=0.6, ls="--")
+
+
+def loglog_rate(x, y):
+    """Least-squares slope of log y against log x (the observed convergence rate)."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    ok = (x > 0) & (y > 0)
+    if ok.sum() < 2:
+        return float("nan")
+    return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0])

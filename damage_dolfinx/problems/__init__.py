@@ -1,0 +1,1 @@
+"""Time-stepping schemes, one module per thesis problem (Problem VP^{hk} of each section)."""

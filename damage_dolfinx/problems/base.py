@@ -1,0 +1,129 @@
+"""What every problem's time stepper shares: data, state, scalars for the history."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Optional, Union
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from .. import compat
+from ..constitutive import eps
+from ..parameters import InputError, ModelParameters, TimeGrid
+from ..solvers import SolveContext
+
+#: a load builder: (x = SpatialCoordinate, t = fem.Constant) -> UFL vector
+LoadBuilder = Callable[[object, object], object]
+
+
+@dataclass
+class ProblemData:
+    """Everything a stepper needs: the example's geometry, data and time grid."""
+    example_id: str
+    geometry: object
+    params: ModelParameters
+    time: TimeGrid
+    body_force: Optional[LoadBuilder] = None
+    traction: Optional[LoadBuilder] = None
+    zeta0: Union[float, Callable] = 1.0
+
+
+class TimeStepper:
+    """Base of the schemes: holds the time level, the solve context and common scalars.
+
+    Subclasses create ``self.u`` (displacement) and ``self.zeta`` (damage), implement
+    ``_initial_state()`` (t = 0) and ``_advance()`` (one step t_{n-1} -> t_n, returning a dict
+    of iteration counts), and list output fields in ``self.output_fields``.
+    """
+
+    def __init__(self, data: ProblemData):
+        self.data, self.params = data, data.params
+        self.mesh = data.geometry.mesh
+        self.comm = self.mesh.comm
+        self.context = SolveContext(example=data.example_id)
+        self.n, self.t = 0, 0.0
+        self.t_const = fem.Constant(self.mesh, 0.0)
+        self.output_fields = []
+
+    # -- time loop interface
+    def initialize(self) -> dict:
+        self._set_time(0)
+        return self._initial_state()
+
+    def advance(self) -> dict:
+        self._set_time(self.n + 1)
+        return self._advance()
+
+    def _set_time(self, n):
+        self.n, self.t = n, self.data.time.t(n)
+        self.t_const.value = self.t
+        self.context.step, self.context.t = n, self.t
+
+    @property
+    def num_steps(self) -> int:
+        return self.data.time.num_steps
+
+    def stop_reason(self) -> Optional[str]:
+        """Why the run must stop early (G43), or None."""
+        if self.params.stop_at_zeta_star and self.zeta_min() <= self.params.zeta_star:
+            return "zeta_star_reached"
+        return None
+
+    # -- helpers for subclasses
+    def interpolate_zeta0(self, zeta):
+        z0 = self.data.zeta0
+        if callable(z0):
+            compat.interpolate(zeta, z0)
+        else:
+            zeta.x.array[:] = float(z0)
+        owned = zeta.x.array[:zeta.function_space.dofmap.index_map.size_local]
+        lo = self.comm.allreduce(owned.min() if owned.size else np.inf, op=MPI.MIN)
+        hi = self.comm.allreduce(owned.max() if owned.size else -np.inf, op=MPI.MAX)
+        if lo < self.params.zeta_star - 1e-12 or hi > 1.0 + 1e-12:
+            raise InputError(f"initial damage must lie in [zeta_star, 1] = [{self.params.zeta_star}, 1]; "
+                             f"got values in [{lo:.4g}, {hi:.4g}]")
+
+    def loads(self):
+        """(f_B, f_N) as UFL expressions of x and the time constant (None where absent)."""
+        x = ufl.SpatialCoordinate(self.mesh)
+        f_B = self.data.body_force(x, self.t_const) if self.data.body_force else None
+        f_N = self.data.traction(x, self.t_const) if self.data.traction else None
+        return f_B, f_N
+
+    # -- scalars
+    def zeta_min(self) -> float:
+        owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
+        return self.comm.allreduce(owned.min() if owned.size else np.inf, op=MPI.MIN)
+
+    def zeta_max(self) -> float:
+        owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
+        return self.comm.allreduce(owned.max() if owned.size else -np.inf, op=MPI.MAX)
+
+    def scalars(self) -> dict:
+        """||u||_L2, ||eps(u)||_L2, min/max/mean zeta (the summary.json 'final' block)."""
+        if not hasattr(self, "_scalar_forms"):
+            self._scalar_forms = {
+                "u_L2": compat.form(ufl.inner(self.u, self.u) * ufl.dx),
+                "eps_u_L2": compat.form(ufl.inner(eps(self.u), eps(self.u)) * ufl.dx),
+                "zeta_integral": compat.form(self.zeta * ufl.dx),
+                "area": compat.form(fem.Constant(self.mesh, 1.0) * ufl.dx)}
+        val = {k: compat.assemble_scalar(f, self.comm) for k, f in self._scalar_forms.items()}
+        return {"u_L2": float(np.sqrt(val["u_L2"])), "eps_u_L2": float(np.sqrt(val["eps_u_L2"])),
+                "zeta_min": float(self.zeta_min()), "zeta_max": float(self.zeta_max()),
+                "zeta_mean": float(val["zeta_integral"] / val["area"])}
+
+    def iteration_totals(self) -> dict:
+        return {}
+
+    def mesh_info(self) -> dict:
+        tdim = self.mesh.topology.dim
+        info = {"cells": self.mesh.topology.index_map(tdim).size_global,
+                "vertices": self.mesh.topology.index_map(0).size_global,
+                "h": self.data.geometry.h, "description": self.data.geometry.description}
+        for name, f in (("u", getattr(self, "u", None)), ("zeta", getattr(self, "zeta", None))):
+            if f is not None:
+                V = f.function_space
+                info[f"dofs_{name}"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+        return info

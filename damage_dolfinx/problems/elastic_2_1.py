@@ -1,0 +1,96 @@
+"""Section 2.1: quasistatic elastic body with damage (PDE damage law), scheme (2.20)-(2.21).
+
+    u_0:  (eta_*(zeta_0) B eps(u_0), eps(w)) = L_0(w)
+    n>=1: (zeta_n - zeta_{n-1}, xi) + k kappa (grad zeta_n, grad xi)
+              = k (phi_B(eps(u_{n-1}), zeta_{n-1}), xi)                      (2.20), linear, SPD
+          (eta_*(zeta_n) B eps(u_n), eps(w)) = L_n(w)                        (2.21), new damage
+
+The damage matrix is constant (assembled and factorised once); the elasticity matrix changes
+with zeta_n and is re-assembled in place each step (same sparsity, so the direct solver reuses
+its symbolic analysis). The run stops when min zeta_n <= zeta_star (G43, flag).
+Solver prefixes: ``damage_`` (damage PDE) and ``mech_`` (elasticity).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import ufl
+from dolfinx import fem
+
+from .. import compat
+from ..damage import DamageStep, source
+from ..forms.elastic_damage import equilibrium_forms, stress
+from ..constitutive import eps, von_mises
+from damage_dolfinx.geometries import GAMMA_D, GAMMA_N
+from ..solvers import LinearSolver
+from .base import ProblemData, TimeStepper
+
+
+class ElasticDamage(TimeStepper):
+    """Problem VP^{hk} of Section 2.1."""
+
+    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+        super().__init__(data)
+        p, msh = self.params, self.mesh
+        V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+        self.u = fem.Function(V, name="u")
+        self.zeta = fem.Function(Z, name="zeta")
+        self.zeta_old = fem.Function(Z, name="zeta_old")
+        self.k = fem.Constant(msh, float(data.time.k))
+        self.kappa = fem.Constant(msh, float(p.kappa))
+
+        # (2.20): source from step n-1 (u still holds u_{n-1} when the damage step runs)
+        phi_old = source(eps(self.u), self.zeta_old, p)
+        self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, self.k, self.kappa,
+                                 self.context, obstacle=False, zeta_star=p.zeta_star,
+                                 prefix=damage_prefix)
+
+        # (2.21): elasticity with the new damage zeta_n
+        tags = data.geometry.facet_tags
+        msh.topology.create_connectivity(1, 2)
+        dsN = ufl.Measure("ds", domain=msh, subdomain_data=tags)(GAMMA_N)
+        w = ufl.TestFunction(V)
+        f_B, f_N = self.loads()
+        a, L = equilibrium_forms(ufl.TrialFunction(V), w, self.zeta, p.E, p.nu, p.zeta_star,
+                                 f_B, f_N, dsN)
+        clamped = tags.indices[tags.values == GAMMA_D]
+        zero = np.zeros(2, dtype=compat.ScalarType)
+        bc = fem.dirichletbc(zero, fem.locate_dofs_topological(V, 1, clamped), V)
+        self.mech = LinearSolver(a, L, [bc], mech_prefix, self.context, constant_matrix=False)
+
+        # output: von Mises of the model stress, DG0 (PROBLEMS.md 1.9)
+        Q = compat.scalar_dg0(msh)
+        self.von_mises = fem.Function(Q, name="von_mises")
+        self._vm_expr = compat.expression(
+            von_mises(stress(self.u, self.zeta, p.E, p.nu, p.zeta_star)), Q)
+        self.output_fields = [self.u, self.zeta, self.von_mises]
+        self.timings = {"damage": 0.0, "mech": 0.0}
+
+    def _initial_state(self) -> dict:
+        self.interpolate_zeta0(self.zeta)
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        its = self._solve_mech()
+        self.update_output()
+        return {"mech_its": its}
+
+    def _advance(self) -> dict:
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        start = time.perf_counter()
+        damage_its = self.damage.solve()
+        self.timings["damage"] += time.perf_counter() - start
+        mech_its = self._solve_mech()
+        return {"damage_its": damage_its, "mech_its": mech_its}
+
+    def _solve_mech(self) -> int:
+        start = time.perf_counter()
+        its = self.mech.solve(self.u)
+        self.timings["mech"] += time.perf_counter() - start
+        return its
+
+    def update_output(self):
+        compat.interpolate(self.von_mises, self._vm_expr)
+
+    def iteration_totals(self) -> dict:
+        return {"damage_ksp": self.damage.iterations, "mech_ksp": self.mech.iterations,
+                "snes": 0}

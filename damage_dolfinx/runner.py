@@ -1,0 +1,143 @@
+"""The time loop of a catalogue run: progress, incremental output, summary.json.
+
+``summary.json`` contract (schema ``damage-dolfinx/summary/v1``; later problems add keys, never
+remove or rename them):
+
+    schema, example, title, section, status ("running" | "completed" | "zeta_star_reached" |
+    "failed"), error (if failed), parameters (all model parameters), n, h, k, T, num_steps
+    (planned), steps_done, t_final, mpi_size, wall_time_s, timings_s, iterations (total solver
+    iterations: damage_ksp, mech_ksp, snes), mesh (cells, vertices, dofs, h, description),
+    final (u_L2, eps_u_L2, zeta_min, zeta_max, zeta_mean at t_final), assumptions, outputs
+    (file names), environment (versions, MPI size, command, date).
+
+The file is rewritten at every output time, so an interrupted run leaves a readable summary
+with status "running" and the CSV history of every finished step.
+"""
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+from mpi4py import MPI
+
+from . import examples, io, post
+from .solvers import ConvergenceError
+
+
+class Progress:
+    """Rank-0 progress lines, at most one every ``interval`` seconds (plus first and last)."""
+
+    def __init__(self, label, total, comm, enabled=True, interval=2.0):
+        self.label, self.total, self.enabled = label, total, enabled and comm.rank == 0
+        self.interval, self.start, self.last = interval, time.perf_counter(), -math.inf
+
+    def __call__(self, step, t, stats, scalars, force=False):
+        now = time.perf_counter()
+        if not self.enabled or (not force and now - self.last < self.interval and step != self.total):
+            return
+        self.last = now
+        elapsed = now - self.start
+        eta = elapsed / max(step, 1) * (self.total - step)
+        its = " ".join(f"{k}={v}" for k, v in stats.items())
+        print(f"[{self.label}] step {step}/{self.total} t={t:.5g} {its} "
+              f"min zeta={scalars['zeta_min']:.4f} ({elapsed:.1f} s, ETA {eta:.0f} s)", flush=True)
+
+
+def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+        write_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
+    """Run one catalogue example and write its outputs to ``out``; returns the summary."""
+    wall_start = time.perf_counter()
+    ex = examples.get(example_id)
+    params, grid, n, h, mesh_file = ex.configure(n, k, T, h, overrides, mesh_file)
+    out = io.prepare_output_dir(out, comm)
+    stepper = ex.build(comm, n, k, T, h, overrides, mesh_file)
+    N = stepper.num_steps
+    write_every = write_every or max(1, N // 20)
+
+    summary = {"schema": "damage-dolfinx/summary/v1", "example": ex.id, "title": ex.title,
+               "section": ex.section, "status": "running", "parameters": params.as_dict(),
+               "n": n, "h": stepper.data.geometry.h, "k": grid.k, "T": grid.T, "num_steps": N,
+               "steps_done": 0, "t_final": 0.0, "mpi_size": comm.size,
+               "mesh": stepper.mesh_info(), "assumptions": ex.assumptions,
+               "outputs": {"xdmf": "fields.xdmf", "history": "history.csv",
+                           "final_fields": "fields_final.npz", "figures": []},
+               "environment": io.environment(comm)}
+    xdmf = io.XDMFSeries(out / "fields.xdmf", stepper.mesh)
+    history = io.CSVHistory(out / "history.csv",
+                            ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
+                             "damage_its", "mech_its", "snes_its", "step_time_s"], comm)
+    report = Progress(ex.id, N, comm, enabled=progress)
+
+    def record(stats, step_time):
+        scalars = stepper.scalars()
+        history.write({"step": stepper.n, "t": stepper.t, **scalars, **stats,
+                       "step_time_s": f"{step_time:.4g}"})
+        summary.update(steps_done=stepper.n, t_final=stepper.t, final=scalars,
+                       iterations=stepper.iteration_totals(),
+                       wall_time_s=time.perf_counter() - wall_start)
+        return scalars
+
+    def write_fields():
+        stepper.update_output()
+        xdmf.write(stepper.output_fields, stepper.t)
+        io.write_json(out / "summary.json", summary, comm)
+
+    try:
+        start = time.perf_counter()
+        stats = stepper.initialize()
+        scalars = record(stats, time.perf_counter() - start)
+        write_fields()
+        report(0, 0.0, stats, scalars, force=True)
+        while stepper.n < N:
+            start = time.perf_counter()
+            stats = stepper.advance()
+            scalars = record(stats, time.perf_counter() - start)
+            stop = stepper.stop_reason()
+            if stop or stepper.n % write_every == 0 or stepper.n == N:
+                write_fields()
+            report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
+            if stop:
+                summary["status"] = stop
+                break
+        else:
+            summary["status"] = "completed"
+    except ConvergenceError as exc:
+        summary.update(status="failed", error=str(exc))
+        io.write_json(out / "summary.json", summary, comm)
+        history.close()
+        raise
+    history.close()
+    io.save_final_fields(out / "fields_final.npz", {"u": stepper.u, "zeta": stepper.zeta})
+    if figures:
+        summary["outputs"]["figures"] = write_figures(ex, stepper, out)
+    summary["timings_s"] = dict(getattr(stepper, "timings", {}))
+    summary["wall_time_s"] = time.perf_counter() - wall_start
+    io.write_json(out / "summary.json", summary, comm)
+    if comm.rank == 0 and progress:
+        print(f"[{ex.id}] {summary['status']} at t = {stepper.t:.5g} after {stepper.n} steps in "
+              f"{summary['wall_time_s']:.1f} s on {comm.size} rank(s); output in {out}", flush=True)
+    return summary
+
+
+def auto_amplification(stepper, diameter) -> float:
+    """G40: the factor that makes the largest displacement 10% of the domain diameter."""
+    import numpy as np
+    u = stepper.u.x.array.reshape(-1, 2)
+    umax = stepper.comm.allreduce(float(np.max(np.linalg.norm(u, axis=1))) if u.size else 0.0,
+                                  op=MPI.MAX)
+    return 0.1 * diameter / umax if umax > 0 else 1.0
+
+
+def write_figures(ex, stepper, out: Path) -> list:
+    """The example's figures (PNG) at the final state; returns their file names."""
+    names = []
+    fields = {"von_mises": (stepper.von_mises, "von Mises stress [Pa]"),
+              "zeta": (stepper.zeta, "damage zeta [-]")}
+    for fig in ex.figures:
+        amp = fig.amplification or auto_amplification(stepper, ex.diameter)
+        post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / fig.filename,
+                         amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})",
+                         outline=True)
+        names.append({"file": fig.filename, "amplification": amp})
+    return names
