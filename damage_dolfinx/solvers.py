@@ -47,16 +47,25 @@ def set_default_options(prefix: str, defaults: dict):
 DIRECT = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
 
+#: CG preconditioned by an exact factorisation of an earlier matrix (lagged), for SPD operators
+#: that change slowly from step to step (damaged elasticity): the factorisation is redone only
+#: when CG needs more than ``refactor_after_its`` iterations.
+LAGGED_DIRECT = {"ksp_type": "cg", "ksp_rtol": 1e-12, "ksp_atol": 1e-50, "ksp_max_it": 200,
+                 "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+
+
 class LinearSolver:
     """Solve a(u, w) = L(w) with Dirichlet conditions by a PETSc KSP.
 
-    With ``constant_matrix=True`` the matrix is assembled and factorised once; otherwise it is
-    re-assembled in place (same sparsity, so a direct solver redoes only the numeric
-    factorisation, the symbolic analysis is reused).
+    With ``constant_matrix=True`` the matrix is assembled and factorised once. Otherwise it is
+    re-assembled in place each solve (same sparsity); with ``refactor_after_its`` set and a
+    Krylov KSP (default options LAGGED_DIRECT) the preconditioner (an exact factorisation of an
+    earlier matrix) is kept until the iteration count exceeds that number, and rebuilt at once
+    if the lagged solve fails.
     """
 
     def __init__(self, a, L, bcs, prefix: str, context: SolveContext, constant_matrix=False,
-                 defaults=None):
+                 defaults=None, refactor_after_its=None):
         self.a, self.L, self.bcs = compat.form(a), compat.form(L), list(bcs)
         self.prefix, self.context, self.constant_matrix = prefix, context, constant_matrix
         self.A = compat.create_matrix(self.a)
@@ -67,8 +76,13 @@ class LinearSolver:
         self.ksp.setOptionsPrefix(prefix)
         self.ksp.setOperators(self.A)
         self.ksp.setFromOptions()
+        self.lagged = bool(refactor_after_its) and not constant_matrix and \
+            self.ksp.getType() != "preonly"
+        self.refactor_after_its = refactor_after_its
+        self._fresh_pc_needed = True
         self.iterations = 0
         self.solves = 0
+        self.factorizations = 0
         self.timings = defaultdict(float)  # seconds: assemble_matrix, assemble_rhs, solve
 
     def assemble_matrix(self):
@@ -95,10 +109,10 @@ class LinearSolver:
             self.assemble_matrix()
         self.assemble_rhs()
         x = compat.petsc_vec(u)
-        start = time.perf_counter()
-        self.ksp.solve(self.b, x)
-        self.timings["solve"] += time.perf_counter() - start
-        reason = self.ksp.getConvergedReason()
+        reason = self._ksp_solve(x)
+        if reason < 0 and self.lagged:  # the lagged factorisation was not good enough: redo it
+            self._fresh_pc_needed = True
+            reason = self._ksp_solve(x)
         if reason < 0:
             r = self.b.duplicate()
             self.A.mult(x, r)
@@ -111,7 +125,21 @@ class LinearSolver:
         its = self.ksp.getIterationNumber()
         self.iterations += its
         self.solves += 1
+        if self.lagged and its > self.refactor_after_its:
+            self._fresh_pc_needed = True
         return its
+
+    def _ksp_solve(self, x) -> int:
+        fresh = self._fresh_pc_needed or not self.lagged
+        if self.lagged:
+            self.ksp.getPC().setReusePreconditioner(not fresh)
+            self._fresh_pc_needed = False
+        if fresh and (self.solves == 0 or not self.constant_matrix):
+            self.factorizations += 1
+        start = time.perf_counter()
+        self.ksp.solve(self.b, x)
+        self.timings["solve"] += time.perf_counter() - start
+        return self.ksp.getConvergedReason()
 
 
 class SNESSolver:

@@ -1,0 +1,188 @@
+"""Convergence study against a fine reference solution (thesis Tables 2.1, 2.4, ...).
+
+The reference run and all coarse runs advance in lockstep: whenever the reference reaches a
+coarse run's next time level, that run takes its step, is transferred exactly to the nested
+reference mesh (:class:`post.NestedTransfer`) and its error is measured there,
+
+    e(n, k) = max over common time levels of ||u_ref - u_hk||_V + ||zeta_ref - zeta_hk||_Y,
+
+so no reference history is stored. Everything runs under MPI. Outputs: ``errors.csv``,
+``errors.md``, ``convergence.png`` (log-log error vs h + k with the fitted rate) and
+``summary.json``.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from . import examples, io, post
+from .parameters import InputError, TimeGrid
+from .runner import Progress
+
+
+class _CoarseRun:
+    def __init__(self, stepper, ref, n, k, ratio):
+        self.stepper, self.n, self.k, self.ratio = stepper, n, k, ratio
+        self.h = stepper.data.geometry.h
+        grid = stepper.data.geometry.grid
+        self.transfer_u = post.NestedTransfer(stepper.u.function_space, ref.u.function_space, grid)
+        self.transfer_z = post.NestedTransfer(stepper.zeta.function_space,
+                                              ref.zeta.function_space, grid)
+        self.u_fine = fem.Function(ref.u.function_space)
+        self.z_fine = fem.Function(ref.zeta.function_space)
+        self.err_u = self.err_z = self.err = 0.0
+        self.wall = 0.0
+
+    def measure(self, norms):
+        self.transfer_u(self.stepper.u, self.u_fine)
+        self.transfer_z(self.stepper.zeta, self.z_fine)
+        eu, ez = norms(self.u_fine, self.z_fine)
+        self.err_u, self.err_z = max(self.err_u, eu), max(self.err_z, ez)
+        self.err = max(self.err, eu + ez)
+
+
+def _check_nested(ref_n, ref_k, ns, ks):
+    for n in ns:
+        if ref_n % n:
+            raise InputError(f"coarse mesh n = {n} is not nested in the reference n = {ref_n}")
+        if n >= ref_n:
+            raise InputError(f"coarse mesh n = {n} must be coarser than the reference n = {ref_n}")
+    for k in ks:
+        ratio = k / ref_k
+        if abs(ratio - round(ratio)) > 1e-8 * ratio or round(ratio) < 1:
+            raise InputError(f"reference k = {ref_k} must divide every coarse k (k = {k})")
+
+
+def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, overrides=None,
+          progress=True, comm=MPI.COMM_WORLD) -> dict:
+    """Run the study; returns the summary (errors per (n, k), fitted rates, wall times)."""
+    wall_start = time.perf_counter()
+    ex = examples.get(example_id)
+    defaults = ex.convergence
+    if defaults is None or ex.n is None:
+        raise InputError(f"example {example_id} has no nested structured meshes; "
+                         "convergence studies need one (e.g. 2.1-ex1)")
+    ref_n = ref_n or defaults["ref_n"]
+    ref_k = ref_k or defaults["ref_k"]
+    ns, ks = list(ns or defaults["n"]), list(ks or defaults["k"])
+    T = T or ex.T
+    _check_nested(ref_n, ref_k, ns, ks)
+    for n in ns + [ref_n]:
+        ex.configure(n=n, k=ref_k, T=T, overrides=overrides)
+    for k in ks:
+        TimeGrid(k, T)
+    out = io.prepare_output_dir(out, comm)
+
+    ref = ex.build(comm, n=ref_n, k=ref_k, T=T, overrides=overrides)
+    norms = post.ErrorNorms(ref.u, ref.zeta)
+    runs = [_CoarseRun(ex.build(comm, n=n, k=k, T=T, overrides=overrides), ref, n, k,
+                       int(round(k / ref_k))) for n in ns for k in ks]
+    report = Progress(f"{ex.id} converge", ref.num_steps, comm, enabled=progress, interval=10.0)
+
+    ref_wall = time.perf_counter()
+    stats = ref.initialize()
+    ref_wall = time.perf_counter() - ref_wall
+    for run in runs:
+        start = time.perf_counter()
+        run.stepper.initialize()
+        run.wall += time.perf_counter() - start
+        run.measure(norms)
+    while ref.n < ref.num_steps:
+        start = time.perf_counter()
+        stats = ref.advance()
+        ref_wall += time.perf_counter() - start
+        for run in runs:
+            if ref.n % run.ratio == 0:
+                start = time.perf_counter()
+                run.stepper.advance()
+                run.wall += time.perf_counter() - start
+                run.measure(norms)
+        report(ref.n, ref.t, stats, ref.scalars())
+
+    rows = [{"n": r.n, "h": r.h, "k": r.k, "h_plus_k": r.h + r.k, "error": r.err,
+             "error_u_V": r.err_u, "error_zeta_L2": r.err_z, "wall_time_s": r.wall} for r in runs]
+    rates = fitted_rates(rows, ns, ks)
+    summary = {"schema": "damage-dolfinx/convergence/v1", "example": ex.id, "title": ex.title,
+               "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
+               "error_definition": "max_n ||u_n - u_n^hk||_V + max_n ||zeta_n - zeta_n^hk||_L2 "
+                                   "taken as max_n of the sum",
+               "errors": rows, "rates": rates, "mpi_size": comm.size,
+               "reference": {"wall_time_s": ref_wall, "mesh": ref.mesh_info(),
+                             "final": ref.scalars(), "iterations": ref.iteration_totals()},
+               "parameters": ref.params.as_dict(), "assumptions": ex.assumptions,
+               "wall_time_s": time.perf_counter() - wall_start,
+               "environment": io.environment(comm)}
+    if comm.rank == 0:
+        write_tables(out, rows, ns, ks, rates, ex.id, ref_n, ref_k)
+        plot_convergence(out / "convergence.png", rows, rates, ex.id, ref_n, ref_k)
+        print((out / "errors.md").read_text(), flush=True)
+    io.write_json(out / "summary.json", summary, comm)
+    return summary
+
+
+def fitted_rates(rows, ns, ks) -> dict:
+    """Observed orders: in h + k over all cells and over the diagonal (n, k) pairs, in h at the
+    smallest k, in k at the finest n."""
+    hk = [r["h_plus_k"] for r in rows]
+    err = [r["error"] for r in rows]
+    k_min, n_max = min(ks), max(ns)
+    col = [r for r in rows if r["k"] == k_min]
+    row = [r for r in rows if r["n"] == n_max]
+    m = min(len(ns), len(ks))
+    diag = [r for r in rows if (r["n"], r["k"]) in
+            zip(sorted(ns)[-m:], sorted(ks, reverse=True)[-m:])]
+    return {"h_plus_k_all": post.loglog_rate(hk, err),
+            "h_plus_k_diagonal": post.loglog_rate([r["h_plus_k"] for r in diag],
+                                                  [r["error"] for r in diag]),
+            "diagonal_pairs": [[r["n"], r["k"]] for r in diag],
+            "h_at_smallest_k": post.loglog_rate([r["h"] for r in col], [r["error"] for r in col]),
+            "k_at_finest_n": post.loglog_rate([r["k"] for r in row], [r["error"] for r in row])}
+
+
+def write_tables(out, rows, ns, ks, rates, example_id, ref_n, ref_k):
+    import csv
+    with open(out / "errors.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    table = {(r["n"], r["k"]): r["error"] for r in rows}
+    lines = [f"# {example_id}: error max_n(||u - u_hk||_V + ||zeta - zeta_hk||_L2), "
+             f"reference n = {ref_n}, k = {ref_k}", "",
+             "| n \\ k | " + " | ".join(f"{k:g}" for k in ks) + " |",
+             "|---|" + "---|" * len(ks)]
+    for n in ns:
+        lines.append(f"| {n} | " + " | ".join(f"{table[(n, k)]:.4e}" for k in ks) + " |")
+    lines += ["", f"Observed rate in h + k (all cells): {rates['h_plus_k_all']:.3f}; "
+              f"diagonal pairs {rates['diagonal_pairs']}: {rates['h_plus_k_diagonal']:.3f}; "
+              f"in h at k = {min(ks):g}: {rates['h_at_smallest_k']:.3f}; "
+              f"in k at n = {max(ns)}: {rates['k_at_finest_n']:.3f}", ""]
+    (out / "errors.md").write_text("\n".join(lines))
+
+
+def plot_convergence(path, rows, rates, example_id, ref_n, ref_k):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    ks = sorted({r["k"] for r in rows}, reverse=True)
+    for k in ks:
+        sel = sorted((r for r in rows if r["k"] == k), key=lambda r: r["h_plus_k"])
+        ax.loglog([r["h_plus_k"] for r in sel], [r["error"] for r in sel], "o-", ms=4,
+                  label=f"k = {k:g}")
+    hk = np.array([r["h_plus_k"] for r in rows])
+    err = np.array([r["error"] for r in rows])
+    p = rates["h_plus_k_all"]
+    c = np.exp(np.mean(np.log(err) - p * np.log(hk)))
+    xs = np.array([hk.min(), hk.max()])
+    ax.loglog(xs, c * xs**p, "k--", label=f"fit: rate {p:.2f}")
+    ax.set_xlabel("h + k")
+    ax.set_ylabel("error (V norm of u + L2 norm of zeta)")
+    ax.set_title(f"{example_id}: convergence (reference n = {ref_n}, k = {ref_k:g})")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
