@@ -210,3 +210,10 @@ def read_msh(comm, path, rank=0, gdim=2):
         from dolfinx.io import gmsh as gmshio
     out = gmshio.read_from_msh(path, comm, rank, gdim=gdim)
     return (out.mesh, out.cell_tags, out.facet_tags) if hasattr(out, "mesh") else out
+
+
+def dofs_in_cells(V):
+    """Local dof (block) indices used by some local cell (a parallel submesh may carry ghost
+    vertices attached to no local cell; their dofs are never assembled)."""
+    dl = V.dofmap.list
+    return np.unique(dl.array if hasattr(dl, "array") else dl)

@@ -108,7 +108,9 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         history.close()
         raise
     history.close()
-    io.save_final_fields(out / "fields_final.npz", {"u": stepper.u, "zeta": stepper.zeta})
+    stepper.update_output()
+    io.save_final_fields(out / "fields_final.npz",
+                         {"u": stepper.u, "zeta": stepper.zeta, "von_mises": stepper.von_mises})
     if figures:
         summary["outputs"]["figures"] = write_figures(ex, stepper, out)
     summary["timings_s"] = dict(getattr(stepper, "timings", {}))

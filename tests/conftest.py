@@ -1,0 +1,40 @@
+"""Shared helpers: run the CLI in a subprocess, serially or under `mpirun -n 2`."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+           OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
+
+
+def run_cli(args, np_=1, check=True, timeout=600):
+    """Run `damage-dolfinx ARGS` (under mpirun -n np_ if np_ > 1); returns CompletedProcess."""
+    cmd = [sys.executable, "-m", "damage_dolfinx.cli", *map(str, args)]
+    if np_ > 1:
+        cmd = ["mpirun", "-n", str(np_), *cmd]
+    proc = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=timeout)
+    if check and proc.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} failed ({proc.returncode}):\n{proc.stdout}\n{proc.stderr}")
+    return proc
+
+
+def load_run(out):
+    """(summary dict, final fields npz) of a finished run folder."""
+    with open(os.path.join(out, "summary.json")) as f:
+        summary = json.load(f)
+    return summary, dict(np.load(os.path.join(out, "fields_final.npz")))
+
+
+def rel_diff(a, b):
+    return float(np.linalg.norm(np.asarray(a) - np.asarray(b)) / max(np.linalg.norm(b), 1e-300))
+
+
+@pytest.fixture
+def unit_square():
+    from mpi4py import MPI
+    from damage_dolfinx import compat
+    return lambda n: compat.create_rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), (n, n))

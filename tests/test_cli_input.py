@@ -1,0 +1,66 @@
+"""Bad input is refused before any computation with one clear line (exit status 2)."""
+import os
+
+import pytest
+
+from damage_dolfinx import cli
+
+
+@pytest.mark.parametrize("args, message", [
+    (["run", "9.9-ex7"], "unknown example id"),
+    (["run", "2.1-ex1", "--set", "zeta_star=1.5"], "zeta_star must lie in (0, 1)"),
+    (["run", "2.1-ex1", "--set", "zeta_star=0"], "zeta_star must lie in (0, 1)"),
+    (["run", "2.1-ex1", "--set", "zeta0=0.001"], "zeta0 must lie in [zeta_star, 1]"),
+    (["run", "2.1-ex1", "--k", "0"], "time step k must be positive"),
+    (["run", "2.1-ex1", "--k", "-0.1"], "time step k must be positive"),
+    (["run", "2.1-ex1", "--T", "0"], "final time T must be positive"),
+    (["run", "2.1-ex1", "--k", "0.3"], "does not divide T"),
+    (["run", "2.1-ex1", "--set", "E=-5"], "Young modulus E must be positive"),
+    (["run", "2.1-ex1", "--set", "nu=0.5"], "Poisson ratio nu must lie in (-1, 0.5)"),
+    (["run", "2.1-ex1", "--set", "kappa=-1"], "kappa must be >= 0"),
+    (["run", "2.1-ex1", "--set", "lam_D=abc"], "cannot read 'abc'"),
+    (["run", "2.1-ex1", "--set", "bogus=1"], "unknown parameter 'bogus'"),
+    (["run", "2.1-ex1", "--n", "0"], "n must be >= 1"),
+    (["run", "2.1-ex1", "--n", "7"], "multiple of"),
+    (["run", "2.1-ex1", "--h", "0.1"], "structured mesh"),
+    (["run", "2.1-ex2a", "--n", "10"], "gmsh mesh"),
+    (["run", "2.1-ex2a", "--mesh", "/nonexistent/disc.msh"], "does not exist"),
+    (["converge", "2.1-ex2a"], "no nested structured meshes"),
+    (["converge", "2.1-ex1", "--ref-n", "40", "--n", "15"], "not nested"),
+    (["converge", "2.1-ex1", "--ref-k", "0.003", "--k", "0.01"], "must divide every coarse k"),
+])
+def test_bad_input_is_refused(tmp_path, capsys, args, message):
+    out = tmp_path / "out"
+    status = cli.main(args + ["--out", str(out)])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert message in err, err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert not (out / "fields.xdmf").exists()
+
+
+def test_unwritable_output_folder(tmp_path, capsys):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    os.chmod(locked, 0o500)
+    try:
+        if os.access(locked, os.W_OK):
+            pytest.skip("running as a user that ignores permissions; use a file as parent")
+        status = cli.main(["run", "2.1-ex1", "--out", str(locked / "run")])
+    finally:
+        os.chmod(locked, 0o700)
+    assert status == 2 and "not writable" in capsys.readouterr().err
+
+
+def test_output_under_a_file_is_refused(tmp_path, capsys):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")
+    status = cli.main(["run", "2.1-ex1", "--out", str(blocker / "run")])
+    assert status == 2 and "not writable" in capsys.readouterr().err
+
+
+def test_list_names_every_example(capsys):
+    assert cli.main(["list"]) == 0
+    out = capsys.readouterr().out
+    for ex_id in ("2.1-ex1", "2.1-ex2a", "2.1-ex2b"):
+        assert ex_id in out

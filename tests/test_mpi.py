@@ -1,0 +1,39 @@
+"""Parallel coverage: unit tests under `mpirun -n 2`, and a convergence study that gives the
+same error table in serial and on two ranks."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from conftest import ENV, run_cli
+
+HERE = Path(__file__).parent
+
+
+@pytest.mark.mpi
+def test_unit_tests_pass_on_two_ranks():
+    cmd = ["mpirun", "-n", "2", sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
+           str(HERE / "test_transfer.py"), str(HERE / "test_damage_step.py")]
+    proc = subprocess.run(cmd, env=ENV, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+@pytest.mark.mpi
+def test_convergence_table_serial_equals_two_ranks(tmp_path):
+    args = ["converge", "2.1-ex1", "--ref-n", "20", "--ref-k", "0.05", "--n", "5", "10",
+            "--k", "0.1", "--T", "0.5", "--quiet"]
+    run_cli(args + ["--out", tmp_path / "s"])
+    run_cli(args + ["--out", tmp_path / "p"], np_=2)
+    s = json.loads((tmp_path / "s" / "summary.json").read_text())
+    p = json.loads((tmp_path / "p" / "summary.json").read_text())
+    assert p["mpi_size"] == 2
+    for rs, rp in zip(s["errors"], p["errors"]):
+        assert (rs["n"], rs["k"]) == (rp["n"], rp["k"])
+        assert rp["error"] == pytest.approx(rs["error"], rel=1e-8)
+    # the error decreases with h + k (the table is not trivially zero)
+    errs = [r["error"] for r in s["errors"]]
+    assert errs[0] > errs[1] > 0
+    for name in ("errors.csv", "errors.md", "convergence.png"):
+        assert (tmp_path / "p" / name).exists()
