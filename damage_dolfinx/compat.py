@@ -217,3 +217,15 @@ def dofs_in_cells(V):
     vertices attached to no local cell; their dofs are never assembled)."""
     dl = V.dofmap.list
     return np.unique(dl.array if hasattr(dl, "array") else dl)
+
+
+def facet_vertex_coords(msh, facets):
+    """(len(facets), 2, 2) coordinates of the end points of the given local facets."""
+    facets = np.asarray(facets, dtype=np.int32)
+    if facets.size == 0:
+        return np.zeros((0, 2, 2))
+    if hasattr(dmesh, "entities_to_geometry"):
+        nodes = dmesh.entities_to_geometry(msh, 1, facets, False)
+    else:
+        nodes = dolfinx.cpp.mesh.entities_to_geometry(msh, 1, facets, False)
+    return msh.geometry.x[nodes][:, :, :2]

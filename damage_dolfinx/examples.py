@@ -23,6 +23,7 @@ class Figure:
     title: str
     fields: tuple = ("von_mises", "zeta")
     amplification: Optional[float] = None  # None: largest displacement = 10% of diameter (G40)
+    kind: str = "fields"                   # "fields" (final state) or "mesh" (setting and mesh)
 
 
 @dataclass
@@ -104,7 +105,8 @@ def _section_2_1():
         assumptions=common_assumptions + [
             "G10: structured n x n grid, diagonals 'right', hole cells removed (nested meshes)",
             "run defaults n = 20, k = 0.01 (quick); the thesis study uses reference n = 160, k = 5e-4"],
-        figures=[Figure("figure_2_1_setting.png", "Example 2.1-1: von Mises stress and damage")],
+        figures=[Figure("figure_2_1.png", "Example 2.1-1: setting and mesh", kind="mesh"),
+                 Figure("fields_final.png", "Example 2.1-1: von Mises stress and damage")],
         convergence=dict(ref_n=160, ref_k=5e-4, n=[5, 10, 20, 40, 80],
                          k=[0.05, 0.02, 0.01, 0.005, 0.002, 0.001]))
 
@@ -122,7 +124,8 @@ def _section_2_1():
                 "G2: gmsh h = 0.1 (h/2 = 0.05 near the diamond corners), k = 0.01",
                 "G1 (revised) applied to Example 2 as well: kappa = 1 (PROBLEMS.md's example line "
                 "still says 1e-2; G1 supersedes it; override with --set kappa=0.01)"],
-            figures=[Figure(figure, f"Example 2.1-2 ({kind} damage only): von Mises stress and "
+            figures=[Figure("figure_2_3.png", "Example 2.1-2: setting and mesh", kind="mesh"),
+                     Figure(figure, f"Example 2.1-2 ({kind} damage only): von Mises stress and "
                             "damage")])
 
     return [ex1,

@@ -130,6 +130,40 @@ def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None)
     plt.close(fig)
 
 
+def plot_mesh(geometry, path, title="", labels=None):
+    """The mesh with its tagged boundary parts coloured (thesis 'setting' figures); collective."""
+    msh, tags = geometry.mesh, geometry.facet_tags
+    xy = msh.comm.gather(compat.cell_vertex_coords(msh), root=0)
+    parts = {}
+    for tag in (labels or {}):
+        local = compat.facet_vertex_coords(msh, tags.indices[tags.values == tag])
+        parts[tag] = msh.comm.gather(local, root=0)
+    if msh.comm.rank != 0:
+        return
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection, PolyCollection
+    fig, ax = plt.subplots(figsize=(5.6, 5.2))
+    ax.add_collection(PolyCollection(np.concatenate(xy), facecolors="none", edgecolors="0.55",
+                                     linewidths=0.5))
+    for (tag, label), color in zip((labels or {}).items(), ("tab:red", "tab:blue", "tab:green")):
+        segs = np.concatenate(parts[tag])
+        if segs.size == 0:
+            continue
+        ax.add_collection(LineCollection(segs, colors=color, linewidths=2.2, label=label))
+    ax.autoscale()
+    ax.set_aspect("equal")
+    ax.set_xlabel("x1 [m]")
+    ax.set_ylabel("x2 [m]")
+    ax.set_title(title)
+    if labels:
+        ax.legend(loc="upper right", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
 def _draw_outline(ax, xy):
     """Boundary edges (edges belonging to one triangle only) of the undeformed mesh."""
     edges = np.concatenate([xy[:, [0, 1]], xy[:, [1, 2]], xy[:, [2, 0]]])

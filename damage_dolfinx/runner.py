@@ -22,6 +22,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from . import examples, io, post
+from .geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .solvers import ConvergenceError
 
 
@@ -137,6 +138,12 @@ def write_figures(ex, stepper, out: Path) -> list:
     fields = {"von_mises": (stepper.von_mises, "von Mises stress [Pa]"),
               "zeta": (stepper.zeta, "damage zeta [-]")}
     for fig in ex.figures:
+        if fig.kind == "mesh":
+            post.plot_mesh(stepper.data.geometry, out / fig.filename, title=fig.title,
+                           labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",
+                                   GAMMA_C: "Gamma_C (contact)"})
+            names.append({"file": fig.filename})
+            continue
         amp = fig.amplification or auto_amplification(stepper, ex.diameter)
         post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / fig.filename,
                          amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})",
