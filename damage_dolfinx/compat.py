@@ -224,8 +224,9 @@ def facet_vertex_coords(msh, facets):
     facets = np.asarray(facets, dtype=np.int32)
     if facets.size == 0:
         return np.zeros((0, 2, 2))
-    if hasattr(dmesh, "entities_to_geometry"):
+    if hasattr(dmesh, "entities_to_geometry"):  # 0.7+
         nodes = dmesh.entities_to_geometry(msh, 1, facets, False)
     else:
-        nodes = dolfinx.cpp.mesh.entities_to_geometry(msh, 1, facets, False)
+        cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))
+        nodes = dolfinx.cpp.mesh.entities_to_geometry(cpp_mesh, 1, facets, False)
     return msh.geometry.x[nodes][:, :, :2]
