@@ -15,7 +15,7 @@ export MPLBACKEND := Agg
 
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix \
     python3-ffcx python3-gmsh gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
-    python3-venv python3-setuptools
+    python3-venv python3-setuptools gcc
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
 .PHONY: setup system-deps demo test test-serial test-mpi bench convergence clean
@@ -30,7 +30,7 @@ system-deps:
 	else \
 	  echo "setup: installing the Debian FEniCSx stack (apt-get)"; \
 	  $(SUDO) apt-get update && \
-	  DEBIAN_FRONTEND=noninteractive $(SUDO) -E apt-get install -y --no-install-recommends $(APT_PACKAGES); \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) -E apt-get install -y $(APT_PACKAGES); \
 	fi
 
 $(VENV)/.installed: pyproject.toml | system-deps
@@ -38,11 +38,12 @@ $(VENV)/.installed: pyproject.toml | system-deps
 	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
 	touch $@
 
-# A real thesis example end to end (Section 2.1 Example 2, both damage variants, coarse mesh).
+# Real thesis examples end to end: Section 2.1 Example 2 at the thesis resolution (h = 0.1,
+# k = 0.01; tension-only serially, compression-only on $(NP) ranks) and Example 1 at n = 40.
 demo: setup
-	$(PY) -m damage_dolfinx.cli run 2.1-ex2a --h 0.2 --out $(OUT)/demo/2.1-ex2a
-	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex2b --h 0.2 --out $(OUT)/demo/2.1-ex2b
-	$(PY) -m damage_dolfinx.cli run 2.1-ex1 --n 20 --k 0.01 --out $(OUT)/demo/2.1-ex1
+	$(PY) -m damage_dolfinx.cli run 2.1-ex2a --out $(OUT)/demo/2.1-ex2a
+	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex2b --out $(OUT)/demo/2.1-ex2b
+	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex1 --n 40 --k 0.005 --out $(OUT)/demo/2.1-ex1
 	@echo "demo output (XDMF for ParaView, PNG figures, CSV, summary.json) in $(OUT)/demo/"
 
 test: setup

@@ -67,7 +67,8 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     xdmf = io.XDMFSeries(out / "fields.xdmf", stepper.mesh)
     history = io.CSVHistory(out / "history.csv",
                             ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
-                             "damage_its", "mech_its", "snes_its", "step_time_s"], comm)
+                             "damage_its", "mech_its", "snes_its", "step_time_s",
+                             *stepper.extra_history_columns], comm)
     report = Progress(ex.id, N, comm, enabled=progress)
 
     def record(stats, step_time):
@@ -76,7 +77,7 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                        "step_time_s": f"{step_time:.4g}"})
         summary.update(steps_done=stepper.n, t_final=stepper.t, final=scalars,
                        iterations=stepper.iteration_totals(),
-                       wall_time_s=time.perf_counter() - wall_start)
+                       wall_time_s=time.perf_counter() - wall_start, **stepper.summary_extra())
         return scalars
 
     def write_fields():

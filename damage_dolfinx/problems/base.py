@@ -33,10 +33,15 @@ class ProblemData:
 class TimeStepper:
     """Base of the schemes: holds the time level, the solve context and common scalars.
 
-    Subclasses create ``self.u`` (displacement) and ``self.zeta`` (damage), implement
-    ``_initial_state()`` (t = 0) and ``_advance()`` (one step t_{n-1} -> t_n, returning a dict
-    of iteration counts), and list output fields in ``self.output_fields``.
+    Subclasses create ``self.u`` (displacement), ``self.zeta`` (damage) and ``self.von_mises``
+    (DG0), implement ``_initial_state()`` (t = 0), ``_advance()`` (one step t_{n-1} -> t_n,
+    returning a dict of iteration counts) and ``update_output()``, and list output fields in
+    ``self.output_fields``. Hooks for problem-specific output: ``extra_history_columns`` (keys
+    that ``scalars()`` or the step stats add to history.csv) and ``summary_extra()`` (keys added
+    to summary.json).
     """
+
+    extra_history_columns: list = []
 
     def __init__(self, data: ProblemData):
         self.data, self.params = data, data.params
@@ -115,6 +120,10 @@ class TimeStepper:
                 "zeta_mean": float(val["zeta_integral"] / val["area"])}
 
     def iteration_totals(self) -> dict:
+        return {}
+
+    def summary_extra(self) -> dict:
+        """Problem-specific summary.json keys (e.g. a failure load); none by default."""
         return {}
 
     def mesh_info(self) -> dict:

@@ -1,0 +1,1 @@
+"""Thesis examples, one module per section; each defines examples() -> [Example]."""
