@@ -75,7 +75,7 @@ class Example:
 
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
-SECTIONS = ["section_2_1"]
+SECTIONS = ["section_2_1", "section_2_3", "bridge"]
 
 
 def catalogue() -> dict:

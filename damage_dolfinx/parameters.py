@@ -53,6 +53,10 @@ class ModelParameters:
                 raise InputError(f"{name} must be >= 0, got {getattr(self, name)}")
         if not (self.L_trunc > 0):
             raise InputError(f"L_trunc must be positive (inf for none), got {self.L_trunc}")
+        for name, value in self.extra.items():
+            rule = EXTRA_RULES.get(name)
+            if rule is not None and not rule[0](value):
+                raise InputError(f"{name} {rule[1]}, got {name} = {value!r}")
         return self
 
     def replace(self, **changes) -> "ModelParameters":
@@ -72,6 +76,22 @@ class ModelParameters:
         d = dataclasses.asdict(self)
         d.update(d.pop("extra"))
         return {k: (str(v) if isinstance(v, float) and math.isinf(v) else v) for k, v in d.items()}
+
+
+#: checks of the problem-specific parameters kept in ModelParameters.extra
+EXTRA_RULES = {
+    "c_nu": (lambda v: v > 0, "(normal compliance stiffness) must be positive"),
+    "rho": (lambda v: v > 0, "(density) must be positive"),
+    "m_visc": (lambda v: v > 0, "(viscosity divisor, A = B/m_visc) must be positive"),
+    "g_fric": (lambda v: v >= 0, "(friction bound) must be >= 0"),
+    "eps_reg": (lambda v: v > 0, "(friction regularisation) must be positive"),
+    "mu_f": (lambda v: v >= 0, "(friction coefficient) must be >= 0"),
+    "memory_kernel": (lambda v: v in ("constant", "exponential"),
+                      "must be 'constant' or 'exponential'"),
+    "memory_rate": (lambda v: v >= 0, "(decay rate of the exponential kernel) must be >= 0"),
+    "memory_mode": (lambda v: v in ("auto", "running", "recursive", "sum"),
+                    "must be one of auto, running, recursive, sum"),
+}
 
 
 def _coerce(old, value, key):

@@ -212,3 +212,38 @@ def form_callbacks(F, J, u, bcs):
         A.assemble()
 
     return residual, jacobian, compat.create_vector(F_form), compat.create_matrix(J_form)
+
+
+#: Newton defaults (semismooth Newton on max(., 0) terms); override with -<prefix>snes_* options
+NEWTON = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol": 1e-10,
+          "snes_atol": 1e-10, "snes_stol": 1e-14, "snes_max_it": 50,
+          "snes_divergence_tolerance": -1, **DIRECT}
+
+
+class NonlinearSolver:
+    """Newton (PETSc SNES) for F(u; w) = 0 with Dirichlet conditions, Jacobian from UFL."""
+
+    def __init__(self, F, u, bcs, prefix: str, context: SolveContext, defaults=None):
+        import ufl
+        self.u = u
+        J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
+        residual, jacobian, b, A = form_callbacks(F, J, u, bcs)
+        self.snes = SNESSolver(u.function_space.mesh.comm, prefix, context, residual, jacobian,
+                               b, A, NEWTON if defaults is None else defaults)
+        self.timings = defaultdict(float)
+
+    def solve(self) -> int:
+        """Solve from the current value of u (warm start); returns Newton iterations."""
+        start = time.perf_counter()
+        its = self.snes.solve(compat.petsc_vec(self.u))
+        self.u.x.scatter_forward()
+        self.timings["solve"] += time.perf_counter() - start
+        return its
+
+    @property
+    def iterations(self):
+        return self.snes.iterations
+
+    @property
+    def linear_iterations(self):
+        return self.snes.linear_iterations

@@ -14,5 +14,8 @@ def damage_step_forms(zeta, xi, zeta_old, phi_old, k, kappa):
     """(a, L) of the implicit damage step: zeta and xi are trial/test functions of B^h."""
     dx = ufl.dx
     a = zeta * xi * dx + k * kappa * ufl.inner(ufl.grad(zeta), ufl.grad(xi)) * dx
-    L = zeta_old * xi * dx + k * phi_old * xi * dx(metadata={"quadrature_degree": SOURCE_DEGREE})
+    L = zeta_old * xi * dx
+    source = k * phi_old * xi
+    if not isinstance(source, ufl.constantvalue.Zero):  # phi = 0 (e.g. all lambdas zero)
+        L += source * dx(metadata={"quadrature_degree": SOURCE_DEGREE})
     return a, L

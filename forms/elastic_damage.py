@@ -14,13 +14,13 @@ def stress(u, zeta, E, nu, zeta_star):
 
 
 def load(w, f_B, f_N, dsN):
-    """L_n(w) = (f_B, w) + (f_N, w)_{Gamma_N}; either load may be None."""
+    """L_n(w) = (f_B, w) + (f_N, w)_{Gamma_N}; either load may be None (both None -> None)."""
     terms = []
     if f_B is not None:
         terms.append(ufl.inner(f_B, w) * ufl.dx)
     if f_N is not None:
         terms.append(ufl.inner(f_N, w) * dsN)
-    return sum(terms[1:], terms[0])
+    return sum(terms[1:], terms[0]) if terms else None
 
 
 def equilibrium_forms(u, w, zeta, E, nu, zeta_star, f_B, f_N, dsN):

@@ -1,0 +1,226 @@
+"""Section 2.1 Example 3: collapse of a masonry arch ring (scheme (2.20)-(2.21) of
+:class:`ElasticDamage`, plus the load history, the failure criterion and the hinges).
+
+Loads (PROBLEMS.md G3): self weight f_B = (0, -rho g) from t = 0 and a vertical load
+P(t) = load_rate * t [kN per metre of out-of-plane thickness] at quarter span, applied as the
+uniform traction f_N = (0, -P(t)/|Gamma_N|) on the load patch Gamma_N (so that its resultant is
+exactly P whatever the mesh).
+
+Failure (thesis, Section 2.1 Example 3): "collapse occurs at the loading step for which a whole
+cross-section of the bridge reaches the lower bound for the damage zeta_*". A cross-section is a
+radial grid line j of the ring (n_r + 1 nodes on the structured mesh; on an unstructured mesh the
+nodes whose polar angle is nearest to theta_j); it has failed when the maximum of zeta_n over
+its nodes is <= zeta_star. The failure load is P(t_n) at the first such step n.
+
+Hinges (the mechanism, thesis Figures 2.8-2.9): the sections where damage has cut through the
+ring. For every section the *damaged depth* d_j is the fraction of its nodes with zeta_n <=
+``hinge_zeta`` (default 0.5: stiffness halved); a hinge is a local maximum of d_j along the ring
+with d_j >= ``hinge_depth`` (default 0.5: more than half the thickness), neighbouring maxima
+closer than ``hinge_separation`` (default: one ring thickness) being merged into the deeper one.
+For each hinge the face where damage starts (intrados or extrados: the face whose node has the
+smaller zeta) is reported, which is what distinguishes the alternating hinges of Heyman's
+four-hinge mechanism.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from .. import compat
+from damage_dolfinx.geometries import GAMMA_N
+from ..parameters import InputError
+from .base import ProblemData
+from .elastic_2_1 import ElasticDamage
+
+#: problem-specific parameters (ModelParameters.extra) and their defaults
+BRIDGE_DEFAULTS = {
+    "rho": 2200.0,           # density [kg/m^3]
+    "gravity": 9.81,         # [m/s^2]; self weight f_B = (0, -rho*gravity)
+    "load_rate": 1000.0,     # dP/dt [kN/s] of the quarter-span load (per metre of thickness)
+    "hinge_zeta": 0.5,       # a node is 'damaged' for the hinge count when zeta <= hinge_zeta
+    "hinge_depth": 0.5,      # a hinge needs damaged depth >= hinge_depth (fraction of section)
+    "hinge_separation": 0.0,  # merge hinges closer than this [m]; 0 = one ring thickness
+}
+
+
+def check_bridge_parameters(extra: dict):
+    """Refuse invalid bridge data (InputError) before any work."""
+    rules = {"rho": (lambda v: v >= 0, "(density) must be >= 0"),
+             "gravity": (lambda v: v >= 0, "must be >= 0"),
+             "load_rate": (lambda v: v >= 0, "(kN/s) must be >= 0"),
+             "hinge_zeta": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
+             "hinge_depth": (lambda v: 0 < v <= 1, "must lie in (0, 1]"),
+             "hinge_separation": (lambda v: v >= 0, "(m) must be >= 0")}
+    for name, (ok, text) in rules.items():
+        value = extra.get(name, BRIDGE_DEFAULTS[name])
+        if not isinstance(value, (int, float)) or not math.isfinite(value) or not ok(value):
+            raise InputError(f"{name} {text}, got {name} = {value!r}")
+
+
+class BridgeDamage(ElasticDamage):
+    """Problem VP^{hk} of Section 2.1 on the arch ring, with the collapse criterion."""
+
+    extra_history_columns = ["P_kN", "u_load_y", "weakest_section", "weakest_section_zeta_max",
+                             "n_hinges"]
+
+    def __init__(self, data: ProblemData, **kwargs):
+        geo = data.geometry
+        if not hasattr(geo, "section_index"):
+            raise InputError("example 2.1-ex3 needs the arch geometry (geometries/bridge.py); "
+                             "external --mesh files are not supported")
+        extra = {**BRIDGE_DEFAULTS, **data.params.extra}
+        check_bridge_parameters(extra)
+        self.bridge = extra
+        super().__init__(data, **kwargs)
+        self._setup_sections(geo)
+        self._patch_uy = compat.form(self.u[1] * self._dsN)
+        self.failure: Optional[dict] = None
+        self._sections = None
+
+    # -- loads (G3)
+    def loads(self):
+        """f_B = (0, -rho g), f_N = (0, -1000 P(t)/|Gamma_N|) N/m^2 with P(t) = load_rate t kN."""
+        msh = self.mesh
+        msh.topology.create_connectivity(1, 2)
+        self._dsN = ufl.Measure("ds", domain=msh, subdomain_data=self.data.geometry.facet_tags)(GAMMA_N)
+        self.patch_length = compat.assemble_scalar(fem.Constant(msh, 1.0) * self._dsN, self.comm)
+        if not self.patch_length > 0:
+            raise InputError("the arch mesh has no load patch (facet tag GAMMA_N)")
+        weight = self.bridge["rho"] * self.bridge["gravity"]
+        f_B = ufl.as_vector((0.0, -weight))
+        f_N = ufl.as_vector((0.0, -1000.0 * self.bridge["load_rate"] * self.t_const / self.patch_length))
+        return f_B, f_N
+
+    def load_kN(self, t=None) -> float:
+        """P(t) in kN (per metre of out-of-plane thickness)."""
+        return self.bridge["load_rate"] * (self.t if t is None else t)
+
+    # -- cross-sections of the ring
+    def _setup_sections(self, geo):
+        """Section index of every owned ring node of the damage space, and the global count of
+        nodes per section (n_r + 1 on the structured grid)."""
+        Z = self.zeta.function_space
+        n_owned = Z.dofmap.index_map.size_local
+        x = Z.tabulate_dof_coordinates()[:n_owned]
+        j = geo.section_index(x)
+        keep = geo.in_ring(x) & (j >= 0) & (j <= geo.n_theta)
+        self._sec_dofs = np.flatnonzero(keep).astype(np.int32)
+        self._sec_j = j[keep]
+        d = x[keep, :2] - np.asarray(geo.centre)
+        r = np.hypot(d[:, 0], d[:, 1])
+        self._sec_r = r
+        ns = geo.n_theta + 1
+        count = np.bincount(self._sec_j, minlength=ns).astype(np.int64)
+        self.section_nodes = self.comm.allreduce(count, op=MPI.SUM)
+        # intrados / extrados node of each section (face of the first damage)
+        tol = 1e-6 * geo.r_out
+        self._on_in = np.abs(r - geo.r_in) < tol
+        self._on_out = np.abs(r - geo.r_out) < tol
+        if self.section_nodes.min() < 2:
+            raise InputError(f"mesh too coarse for the section criterion: a section of the ring "
+                             f"has {self.section_nodes.min()} node(s)")
+
+    def section_stats(self) -> dict:
+        """Per section j = 0..n_theta (global, on every rank): max and min of zeta_n, damaged
+        depth (fraction of nodes with zeta <= hinge_zeta), zeta at intrados and extrados."""
+        ns = self.data.geometry.n_theta + 1
+        z = self.zeta.x.array[self._sec_dofs]
+        j = self._sec_j
+        zmax, zmin = np.full(ns, -np.inf), np.full(ns, np.inf)
+        np.maximum.at(zmax, j, z)
+        np.minimum.at(zmin, j, z)
+        damaged = np.bincount(j, weights=(z <= self.bridge["hinge_zeta"]).astype(float),
+                              minlength=ns)
+        z_in, z_out = np.full(ns, np.inf), np.full(ns, np.inf)
+        np.minimum.at(z_in, j[self._on_in], z[self._on_in])
+        np.minimum.at(z_out, j[self._on_out], z[self._on_out])
+        c = self.comm
+        return {"zeta_max": c.allreduce(zmax, op=MPI.MAX), "zeta_min": c.allreduce(zmin, op=MPI.MIN),
+                "depth": c.allreduce(damaged, op=MPI.SUM) / self.section_nodes,
+                "zeta_intrados": c.allreduce(z_in, op=MPI.MIN),
+                "zeta_extrados": c.allreduce(z_out, op=MPI.MIN)}
+
+    def hinges(self, stats: dict) -> list:
+        """Local maxima of the damaged depth d_j >= hinge_depth, merged within hinge_separation
+        (see the module docstring); each with section, abscissa, angle and damaged face."""
+        geo = self.data.geometry
+        depth = stats["depth"]
+        sep = self.bridge["hinge_separation"] or geo.options.get("thickness", geo.r_out - geo.r_in)
+        padded = np.concatenate([[-1.0], depth, [-1.0]])
+        peak = (depth >= self.bridge["hinge_depth"]) & (depth >= padded[:-2]) & (depth >= padded[2:])
+        cand = np.flatnonzero(peak)
+        # strongest first: deeper, then lower zeta_min; keep if far from those already kept
+        order = cand[np.lexsort((stats["zeta_min"][cand], -depth[cand]))]
+        pts = geo.section_points(np.arange(depth.size))
+        kept = []
+        for j in order:  # loop over a handful of candidate sections, not over dofs
+            if all(abs(pts["s"][j] - pts["s"][i]) >= sep for i in kept):
+                kept.append(j)
+        out = []
+        for j in sorted(kept):
+            face = "intrados" if stats["zeta_intrados"][j] < stats["zeta_extrados"][j] else "extrados"
+            out.append({"section": int(j), "s_m": round(float(pts["s"][j]), 4),
+                        "angle_deg": round(float(pts["angle_deg"][j]), 3),
+                        "x_m": round(float(pts["x"][j]), 4), "y_m": round(float(pts["y"][j]), 4),
+                        "damaged_depth": round(float(depth[j]), 4),
+                        "zeta_max": float(stats["zeta_max"][j]),
+                        "first_damaged_face": face})
+        return out
+
+    # -- runner hooks
+    def scalars(self) -> dict:
+        """Base scalars plus load, displacement under the load, weakest section, hinges; detects
+        collapse (a section with max zeta_n <= zeta_star)."""
+        out = super().scalars()
+        stats = self.section_stats()
+        self._sections = stats
+        weakest = int(np.argmin(stats["zeta_max"]))
+        hinges = self.hinges(stats)
+        self._hinges = hinges
+        u_y = compat.assemble_scalar(self._patch_uy, self.comm) / self.patch_length
+        out.update(P_kN=self.load_kN(), u_load_y=u_y, weakest_section=weakest,
+                   weakest_section_zeta_max=float(stats["zeta_max"][weakest]),
+                   n_hinges=len(hinges))
+        failed = np.flatnonzero(stats["zeta_max"] <= self.params.zeta_star)
+        if failed.size and self.failure is None and self.n > 0:
+            pts = self.data.geometry.section_points(failed)
+            self.failure = {"step": self.n, "t": self.t, "P_kN": self.load_kN(),
+                            "u_load_y": u_y, "sections": failed.tolist(),
+                            "s_m": np.round(pts["s"], 4).tolist(),
+                            "angle_deg": np.round(pts["angle_deg"], 3).tolist()}
+        return out
+
+    def stop_reason(self) -> Optional[str]:
+        if self.failure is not None:
+            return "collapse"
+        return super().stop_reason()
+
+    def summary_extra(self) -> dict:
+        geo = self.data.geometry
+        f = self.failure
+        hinges = getattr(self, "_hinges", [])
+        return {
+            "failure_load_kN": None if f is None else f["P_kN"],
+            "failure_time": None if f is None else f["t"],
+            "failure_step": None if f is None else f["step"],
+            "failed_sections": None if f is None else
+            [{"section": j, "s_m": s, "angle_deg": a}
+             for j, s, a in zip(f["sections"], f["s_m"], f["angle_deg"])],
+            "load_increment_kN": self.bridge["load_rate"] * self.data.time.k,
+            "hinges": hinges, "n_hinges": len(hinges),
+            "hinge_definition": {k: self.bridge[k] for k in ("hinge_zeta", "hinge_depth")} | {
+                "hinge_separation_m": self.bridge["hinge_separation"]
+                or geo.options.get("thickness", geo.r_out - geo.r_in)},
+            "bridge": {"load_rate_kN_per_s": self.bridge["load_rate"],
+                       "self_weight_N_per_m3": self.bridge["rho"] * self.bridge["gravity"],
+                       "x_load_m": geo.x_load, "patch_length_m": self.patch_length,
+                       "n_r": geo.n_r, "n_theta": geo.n_theta, "structured": geo.structured,
+                       "nodes_per_section": [int(self.section_nodes.min()),
+                                             int(self.section_nodes.max())],
+                       "r_in": geo.r_in, "r_out": geo.r_out, **geo.options},
+        }

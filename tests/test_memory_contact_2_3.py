@@ -1,0 +1,108 @@
+"""Section 2.3: normal compliance against a closed-form solution, the three memory evaluations
+against each other, serial = mpirun -n 2, and the physics of Examples 2-3."""
+import csv
+
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from conftest import load_run, rel_diff, run_cli
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
+from damage_dolfinx.geometries.rectangle import rectangle, side
+from damage_dolfinx.parameters import ModelParameters, TimeGrid
+from damage_dolfinx.problems.base import ProblemData
+from damage_dolfinx.problems.memory_2_3 import ViscoelasticMemoryContact
+
+
+def pushed_block(c_nu, E=100.0, H=2.0, g0=0.01, n=4):
+    """Block (0,1)x(0,H), top clamped, bottom on a foundation that overlaps it by g0 (gap = -g0),
+    nu = 0, no damage, no memory: u = (0, alpha (y - H)) with alpha = -c g0 / (E + c H)."""
+    params = ModelParameters(E=E, nu=0.0, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,
+                             stop_at_zeta_star=False,
+                             extra={"c_nu": c_nu, "gap": -g0, "memory_kernel": "constant",
+                                    "memory_amplitude": 0.0})
+    geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, H), n, 2 * n,
+                    {GAMMA_D: side(1, H), GAMMA_C: side(1, 0.0)})
+    stepper = ViscoelasticMemoryContact(ProblemData("nc-test", geo, params, TimeGrid(1.0, 1.0)))
+    stepper.initialize()
+    X = stepper.u.function_space.tabulate_dof_coordinates()
+    u = stepper.u.x.array.reshape(-1, 2)
+    alpha = -c_nu * g0 / (E + c_nu * H)
+    return u, alpha * (X[:, 1] - H), g0 - u[np.isclose(X[:, 1], 0.0), 1]
+
+
+@pytest.mark.parametrize("c_nu", [1e1, 1e3, 1e6])
+def test_normal_compliance_closed_form(c_nu):
+    u, u_y_exact, _ = pushed_block(c_nu)
+    assert np.max(np.abs(u[:, 0])) < 1e-12
+    assert np.max(np.abs(u[:, 1] - u_y_exact)) < 1e-10 * np.max(np.abs(u_y_exact))
+
+
+def test_penetration_shrinks_as_stiffness_grows():
+    E, H, g0 = 100.0, 2.0, 0.01
+    pens = []
+    for c in (1e1, 1e2, 1e3, 1e4, 1e6):
+        _, _, pen = pushed_block(c, E, H, g0)
+        assert np.allclose(pen, g0 * E / (E + c * H), rtol=1e-8)
+        pens.append(pen.max())
+    assert all(a > b for a, b in zip(pens, pens[1:]))
+    assert pens[-1] < 1e-3 * g0
+
+
+@pytest.mark.parametrize("example, mode", [("2.3-ex1", "running"), ("2.3-ex3", "recursive")])
+def test_memory_variants_agree(tmp_path, example, mode):
+    """O(1) updates against the plain O(n) sum of (2.136): same fields to round-off."""
+    base = ["run", example, "--n", "4", "--k", "0.05", "--no-figures", "--quiet"]
+    run_cli(base + ["--set", f"memory_mode={mode}", "--out", tmp_path / "fast"])
+    run_cli(base + ["--set", "memory_mode=sum", "--out", tmp_path / "sum"])
+    (_, fast), (_, plain) = load_run(tmp_path / "fast"), load_run(tmp_path / "sum")
+    for name in ("u", "zeta", "von_mises"):
+        assert rel_diff(fast[name], plain[name]) < 1e-12, name
+    assert np.abs(fast["u"]).max() > 1e-3  # a real run
+
+
+def test_memory_mode_must_match_kernel(tmp_path):
+    proc = run_cli(["run", "2.3-ex3", "--n", "4", "--set", "memory_mode=running", "--quiet",
+                    "--out", tmp_path], check=False)
+    assert proc.returncode == 2 and "does not apply" in proc.stderr
+
+
+@pytest.mark.mpi
+def test_example1_serial_equals_two_ranks(tmp_path):
+    args = ["run", "2.3-ex1", "--n", "8", "--k", "0.05", "--no-figures", "--quiet"]
+    run_cli(args + ["--out", tmp_path / "s"])
+    run_cli(args + ["--out", tmp_path / "p"], np_=2)
+    (_, s), (p_sum, p) = load_run(tmp_path / "s"), load_run(tmp_path / "p")
+    assert p_sum["mpi_size"] == 2
+    for name in ("u", "zeta", "von_mises"):
+        assert rel_diff(p[name], s[name]) < 1e-8, name
+
+
+def history(folder):
+    with open(folder / "history.csv") as f:
+        return {round(float(r["t"]), 8): r for r in csv.DictReader(f)}
+
+
+def test_example2_memory_pulls_back(tmp_path):
+    """Figure 2.17: under a constant load the stiffening memory shrinks the deformation."""
+    run_cli(["run", "2.3-ex2", "--n", "4", "--no-figures", "--quiet", "--out", tmp_path])
+    h = history(tmp_path)
+    ratio = float(h[2.0]["eps_u_L2"]) / float(h[0.0]["eps_u_L2"])
+    print(f"||eps(u)|| at t = 2 / at t = 0: {ratio:.3f}")
+    assert ratio < 0.5
+    assert float(h[2.0]["zeta_min"]) < 1.0  # the body is damaged
+
+
+def test_example3_fading_memory_and_residual_stress(tmp_path):
+    """Figures 2.20-2.21: larger deformation at t = 0.5 than at t = 0 under the same load, and
+    a nonzero residual stress at t = 1 after the load is removed."""
+    run_cli(["run", "2.3-ex3", "--n", "4", "--no-figures", "--quiet", "--out", tmp_path])
+    h = history(tmp_path)
+    u0, u_half, u1 = (float(h[t]["u_L2"]) for t in (0.0, 0.5, 1.0))
+    s_half, s1 = float(h[0.5]["stress_L2"]), float(h[1.0]["stress_L2"])
+    print(f"||u||: t=0 {u0:.4f}, t=0.5 {u_half:.4f}, t=1 {u1:.4f}; ||sigma||: t=0.5 {s_half:.3f}, t=1 {s1:.3f}")
+    assert u_half > 1.2 * u0
+    # unloaded at t = 1: the memory leaves a residual deformation and a small self-equilibrated
+    # stress (without memory both would vanish exactly)
+    assert u1 > 0.2 * u0
+    assert s1 > 1e-4 * s_half
