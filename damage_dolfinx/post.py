@@ -100,6 +100,8 @@ def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None)
     """One PNG with a panel per (Function, label) in ``fields``, on the configuration
     x + amplification * u (PROBLEMS.md 1.9); collective, rank 0 draws."""
     gathered = [(gather_cells(u_disp, f, amplification), label) for f, label in fields]
+    # optional colour range of a field: attribute ``plot_range = (vmin, vmax)`` on the Function
+    ranges = [getattr(f, "plot_range", None) or (None, None) for f, _ in fields]
     ref = gather_cells(None, fields[0][0], 0.0) if outline else None
     if MPI.COMM_WORLD.rank != 0 or gathered[0][0] is None:
         return
@@ -109,13 +111,14 @@ def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None)
     import matplotlib.tri as mtri
 
     fig, axes = plt.subplots(1, len(gathered), figsize=(5.6 * len(gathered), 4.8), squeeze=False)
-    for ax, ((xy, vals), label) in zip(axes[0], gathered):
+    for ax, ((xy, vals), label), (vmin, vmax) in zip(axes[0], gathered, ranges):
         pts = xy.reshape(-1, 2)
         tri = mtri.Triangulation(pts[:, 0], pts[:, 1], np.arange(pts.shape[0]).reshape(-1, 3))
         if vals.ndim == 2:
-            im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap="viridis")
+            im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap="viridis",
+                              vmin=vmin, vmax=vmax)
         else:
-            im = ax.tripcolor(tri, facecolors=vals, cmap="viridis")
+            im = ax.tripcolor(tri, facecolors=vals, cmap="viridis", vmin=vmin, vmax=vmax)
         if ref is not None:
             _draw_outline(ax, ref[0])
         ax.set_aspect("equal")

@@ -151,14 +151,17 @@ class SNESSolver:
     """
 
     def __init__(self, comm, prefix: str, context: SolveContext, residual, jacobian, b, A,
-                 defaults: dict, bounds=None):
+                 defaults: dict, bounds=None, P=None):
         self.prefix, self.context = prefix, context
         self._residual_cb, self._jacobian_cb = residual, jacobian
         set_default_options(prefix, defaults)
         self.snes = PETSc.SNES().create(comm)
         self.snes.setOptionsPrefix(prefix)
         self.snes.setFunction(lambda snes, x, f: residual(x, f), b)
-        self.snes.setJacobian(lambda snes, x, J, P: jacobian(x, J), A)
+        if P is None:
+            self.snes.setJacobian(lambda snes, x, J, P_: jacobian(x, J), A)
+        else:  # separate preconditioning matrix, updated by the callback when it chooses
+            self.snes.setJacobian(lambda snes, x, J, P_: jacobian(x, J, P_), A, P)
         if bounds is not None:
             self.snes.setVariableBounds(*bounds)
         self.snes.setFromOptions()
@@ -220,22 +223,62 @@ NEWTON = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol":
           "snes_divergence_tolerance": -1, **DIRECT}
 
 
-class NonlinearSolver:
-    """Newton (PETSc SNES) for F(u; w) = 0 with Dirichlet conditions, Jacobian from UFL."""
+#: Newton with CG preconditioned by a lagged factorisation of an earlier Jacobian (symmetric
+#: Jacobians whose active set rarely changes, e.g. normal compliance): see NonlinearSolver.
+NEWTON_LAGGED = {**NEWTON, **LAGGED_DIRECT}
 
-    def __init__(self, F, u, bcs, prefix: str, context: SolveContext, defaults=None):
+
+class NonlinearSolver:
+    """Newton (PETSc SNES) for F(u; w) = 0 with Dirichlet conditions, Jacobian from UFL.
+
+    With ``refactor_after_its`` (and a Krylov KSP, default options NEWTON_LAGGED) the
+    factorisation of an earlier Jacobian preconditions the current one and is rebuilt only when
+    the previous linear solve needed more than that many iterations: Newton stays exact (the
+    linear systems are solved to rtol 1e-12), the factorisations become rare. The lag works
+    through a separate preconditioning matrix P: PETSc re-factorises only when P changes, and P
+    is refreshed (re-assembled as the current Jacobian) only when needed.
+    """
+
+    def __init__(self, F, u, bcs, prefix: str, context: SolveContext, defaults=None,
+                 refactor_after_its=None):
         import ufl
         self.u = u
         J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
         residual, jacobian, b, A = form_callbacks(F, J, u, bcs)
-        self.snes = SNESSolver(u.function_space.mesh.comm, prefix, context, residual, jacobian,
-                               b, A, NEWTON if defaults is None else defaults)
+        if defaults is None:
+            defaults = NEWTON_LAGGED if refactor_after_its else NEWTON
+        self.refactor_after_its = refactor_after_its
+        self.factorizations = 0
+        self._force_fresh = False
+        P = compat.create_matrix(compat.form(J)) if refactor_after_its else None
+        self.snes = SNESSolver(u.function_space.mesh.comm, prefix, context, residual,
+                               self._lagged(jacobian) if refactor_after_its else jacobian,
+                               b, A, defaults, P=P)
+        self.ksp = self.snes.snes.getKSP()
         self.timings = defaultdict(float)
+
+    def _lagged(self, jacobian):
+        def lagged_jacobian(x, A, P):
+            jacobian(x, A)
+            fresh = (self.factorizations == 0 or self._force_fresh
+                     or self.ksp.getType() == "preonly"
+                     or self.ksp.getIterationNumber() > self.refactor_after_its)
+            if fresh:
+                jacobian(x, P)
+                self.factorizations += 1
+                self._force_fresh = False
+        return lagged_jacobian
 
     def solve(self) -> int:
         """Solve from the current value of u (warm start); returns Newton iterations."""
         start = time.perf_counter()
-        its = self.snes.solve(compat.petsc_vec(self.u))
+        try:
+            its = self.snes.solve(compat.petsc_vec(self.u))
+        except ConvergenceError:
+            if not self.refactor_after_its:
+                raise
+            self._force_fresh = True  # the lagged preconditioner may be to blame: retry once
+            its = self.snes.solve(compat.petsc_vec(self.u))
         self.u.x.scatter_forward()
         self.timings["solve"] += time.perf_counter() - start
         return its

@@ -80,7 +80,8 @@ class BridgeDamage(ElasticDamage):
         self._setup_sections(geo)
         self._patch_uy = compat.form(self.u[1] * self._dsN)
         self.failure: Optional[dict] = None
-        self._sections = None
+        self._hinges = []
+        self.zeta.plot_range = (0.0, 1.0)  # PDE damage may undershoot: colour [0, 1], clipped
 
     # -- loads (G3)
     def loads(self):
@@ -178,7 +179,6 @@ class BridgeDamage(ElasticDamage):
         collapse (a section with max zeta_n <= zeta_star)."""
         out = super().scalars()
         stats = self.section_stats()
-        self._sections = stats
         weakest = int(np.argmin(stats["zeta_max"]))
         hinges = self.hinges(stats)
         self._hinges = hinges
@@ -203,7 +203,7 @@ class BridgeDamage(ElasticDamage):
     def summary_extra(self) -> dict:
         geo = self.data.geometry
         f = self.failure
-        hinges = getattr(self, "_hinges", [])
+        hinges = self._hinges
         return {
             "failure_load_kN": None if f is None else f["P_kN"],
             "failure_time": None if f is None else f["t"],

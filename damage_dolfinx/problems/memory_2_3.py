@@ -29,6 +29,10 @@ from ..solvers import NonlinearSolver
 from .base import ProblemData, TimeStepper
 
 
+#: Krylov iterations above which the lagged Jacobian factorisation is rebuilt
+MECH_REFACTOR_ITS = 10
+
+
 class ViscoelasticMemoryContact(TimeStepper):
     """Problem VP^{hk} of Section 2.3."""
 
@@ -69,7 +73,8 @@ class ViscoelasticMemoryContact(TimeStepper):
         clamped = tags.indices[tags.values == GAMMA_D]
         bc = fem.dirichletbc(np.zeros(2, dtype=compat.ScalarType),
                              fem.locate_dofs_topological(V, 1, clamped), V)
-        self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context)
+        self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
+                                    refactor_after_its=MECH_REFACTOR_ITS)
 
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
@@ -116,4 +121,5 @@ class ViscoelasticMemoryContact(TimeStepper):
 
     def iteration_totals(self) -> dict:
         return {"damage_ksp": self.damage.iterations, "snes": self.mech.iterations,
-                "mech_ksp": self.mech.linear_iterations}
+                "mech_ksp": self.mech.linear_iterations,
+                "mech_factorizations": self.mech.factorizations}
