@@ -53,7 +53,8 @@ bench: setup
 	$(MPIRUN) $(PY) benchmarks/step_timing_2_1.py
 
 convergence: setup
-	$(MPIRUN) $(PY) benchmarks/convergence_2_1_ex1.py
+	$(MPIRUN) $(PY) benchmarks/convergence.py 2.1-ex1
+	$(MPIRUN) $(PY) benchmarks/convergence.py 2.3-ex1
 
 clean:
 	rm -rf $(VENV) results .pytest_cache build *.egg-info

@@ -223,6 +223,15 @@ NEWTON = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol":
           "snes_divergence_tolerance": -1, **DIRECT}
 
 
+def _relative_change(A, P) -> float:
+    """||A - P||_F / ||P||_F for matrices with the same sparsity."""
+    D = A.duplicate(copy=True)
+    D.axpy(-1.0, P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+    change = D.norm(PETSc.NormType.FROBENIUS) / max(P.norm(PETSc.NormType.FROBENIUS), 1e-300)
+    D.destroy()
+    return change
+
+
 #: Newton with CG preconditioned by a lagged factorisation of an earlier Jacobian (symmetric
 #: Jacobians whose active set rarely changes, e.g. normal compliance): see NonlinearSolver.
 NEWTON_LAGGED = {**NEWTON, **LAGGED_DIRECT}
@@ -233,7 +242,8 @@ class NonlinearSolver:
 
     With ``refactor_after_its`` (and a Krylov KSP, default options NEWTON_LAGGED) the
     factorisation of an earlier Jacobian preconditions the current one and is rebuilt only when
-    the previous linear solve needed more than that many iterations: Newton stays exact (the
+    the previous linear solve needed more than that many iterations or the Jacobian changed by
+    more than ``jacobian_change_tol`` (Frobenius, relative): Newton stays exact (the
     linear systems are solved to rtol 1e-12), the factorisations become rare. The lag works
     through a separate preconditioning matrix P: PETSc re-factorises only when P changes, and P
     is refreshed (re-assembled as the current Jacobian) only when needed.
@@ -248,6 +258,7 @@ class NonlinearSolver:
         if defaults is None:
             defaults = NEWTON_LAGGED if refactor_after_its else NEWTON
         self.refactor_after_its = refactor_after_its
+        self.jacobian_change_tol = 1e-3  # e.g. a contact active set that changed
         self.factorizations = 0
         self._force_fresh = False
         P = compat.create_matrix(compat.form(J)) if refactor_after_its else None
@@ -262,7 +273,8 @@ class NonlinearSolver:
             jacobian(x, A)
             fresh = (self.factorizations == 0 or self._force_fresh
                      or self.ksp.getType() == "preonly"
-                     or self.ksp.getIterationNumber() > self.refactor_after_its)
+                     or self.ksp.getIterationNumber() > self.refactor_after_its
+                     or _relative_change(A, P) > self.jacobian_change_tol)
             if fresh:
                 jacobian(x, P)
                 self.factorizations += 1

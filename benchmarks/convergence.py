@@ -1,0 +1,30 @@
+"""Convergence tables of the thesis examples, in parallel (Tables 2.1 and 2.5 so far).
+
+    mpirun -n 2 .venv/bin/python benchmarks/convergence.py 2.3-ex1 [--quick] [--out DIR]
+
+Runs the example's default study (reference and coarse (n, k) from the catalogue, e.g. 2.3-ex1:
+reference n = 256, k = 5e-4; n in {4, ..., 128} x k in {0.05, ..., 0.001}); writes errors.csv,
+errors.md, convergence.png and summary.json (with wall times and MPI size) under
+results/convergence/<id>. ``--quick``: reference n = 32, k = 0.005 (seconds).
+"""
+import argparse
+
+from mpi4py import MPI
+
+from damage_dolfinx import convergence, examples
+
+parser = argparse.ArgumentParser()
+parser.add_argument("id")
+parser.add_argument("--quick", action="store_true")
+parser.add_argument("--out", default=None)
+args = parser.parse_args()
+out = args.out or f"results/convergence/{args.id}" + ("-quick" if args.quick else "")
+if args.quick:
+    study = examples.get(args.id).convergence
+    ns = [n for n in study["n"] if 32 % n == 0 and n < 32][:3]
+    s = convergence.study(args.id, out, ref_n=32, ref_k=0.005, ns=ns, ks=[0.05, 0.02, 0.01])
+else:
+    s = convergence.study(args.id, out)
+if MPI.COMM_WORLD.rank == 0:
+    print(f"wall time {s['wall_time_s']:.1f} s on {s['mpi_size']} rank(s); reference run "
+          f"{s['reference']['wall_time_s']:.1f} s; rates {s['rates']}")
