@@ -20,3 +20,30 @@ def normal_compliance_pressure(u, n, c_nu, gap=0.0):
 def normal_compliance_term(u, w, n, c_nu, gap, dsC):
     """int_{Gamma_C} p_nu(u.nu - gap) w.nu ds."""
     return normal_compliance_pressure(u, n, c_nu, gap) * ufl.dot(w, n) * dsC
+
+
+# ------------------------------------------------------------------ Tresca friction (1.5)
+#: Facet quadrature at the vertices (trapezoidal rule, GLL degree 1): the friction functional
+#: j(w) = int g |w_tau| ds becomes the nodal sum sum_i m_i g_i |w_tau,i| (lumped boundary mass).
+#: All three friction solvers use this same discrete j, so they solve the same discrete problem.
+NODAL_QUADRATURE = {"quadrature_rule": "GLL", "quadrature_degree": 1}
+
+
+def tangent(n):
+    """Unit tangent tau = (-nu_2, nu_1)."""
+    return ufl.as_vector((-n[1], n[0]))
+
+
+def clip(x, lo, hi):
+    return ufl.max_value(lo, ufl.min_value(hi, x))
+
+
+def Phi_reg(r, g, eps_reg):
+    """Regularised friction law (2.99): Phi_eps(r) = g max(-1, min(1, r/eps))."""
+    return g * clip(r / eps_reg, -1.0, 1.0)
+
+
+def F_reg(r, g, eps_reg):
+    """Its potential (2.101): g r^2/(2 eps) for |r| <= eps, g |r| - g eps/2 otherwise."""
+    return ufl.conditional(ufl.le(abs(r), eps_reg), g * r**2 / (2.0 * eps_reg),
+                           g * abs(r) - g * eps_reg / 2.0)

@@ -42,6 +42,7 @@ class Example:
     assumptions: list = field(default_factory=list)
     figures: list = field(default_factory=list)
     convergence: Optional[dict] = None  # default study {ref_n, ref_k, n: [...], k: [...]}
+    builders: dict = field(default_factory=dict)  # problem-specific builders (ProblemData)
 
     def configure(self, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None):
         """Validated (params, time grid, n, h, mesh_file) for a run; raises InputError."""
@@ -70,12 +71,12 @@ class Example:
         else:
             geometry = self.make_geometry(comm, n, h)
         data = ProblemData(self.id, geometry, params, time, self.body_force, self.traction,
-                           self.zeta0)
+                           self.zeta0, self.builders)
         return self.make_stepper(data)
 
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
-SECTIONS = ["section_2_1", "section_2_3", "bridge"]
+SECTIONS = ["section_2_1", "section_2_2", "section_2_3", "bridge"]
 
 
 def catalogue() -> dict:

@@ -243,8 +243,9 @@ class NonlinearSolver:
     With ``refactor_after_its`` (and a Krylov KSP, default options NEWTON_LAGGED) the
     factorisation of an earlier Jacobian preconditions the current one and is rebuilt only when
     the previous linear solve needed more than that many iterations or the Jacobian changed by
-    more than ``jacobian_change_tol`` (Frobenius, relative): Newton stays exact (the
-    linear systems are solved to rtol 1e-12), the factorisations become rare. The lag works
+    more than ``jacobian_change_tol`` (Frobenius, relative; 1e-10, i.e. any change): Newton
+    stays exact (the linear systems are solved to rtol 1e-12, or directly with ``preonly`` when
+    the factorised matrix equals the Jacobian), the factorisations become rare. The lag works
     through a separate preconditioning matrix P: PETSc re-factorises only when P changes, and P
     is refreshed (re-assembled as the current Jacobian) only when needed.
     """
@@ -258,7 +259,7 @@ class NonlinearSolver:
         if defaults is None:
             defaults = NEWTON_LAGGED if refactor_after_its else NEWTON
         self.refactor_after_its = refactor_after_its
-        self.jacobian_change_tol = 1e-3  # e.g. a contact active set that changed
+        self.jacobian_change_tol = 1e-10  # any change, e.g. of a contact or stick set
         self.factorizations = 0
         self._force_fresh = False
         P = compat.create_matrix(compat.form(J)) if refactor_after_its else None
@@ -271,9 +272,9 @@ class NonlinearSolver:
     def _lagged(self, jacobian):
         def lagged_jacobian(x, A, P):
             jacobian(x, A)
+            krylov = self.ksp.getType() != "preonly"
             fresh = (self.factorizations == 0 or self._force_fresh
-                     or self.ksp.getType() == "preonly"
-                     or self.ksp.getIterationNumber() > self.refactor_after_its
+                     or (krylov and self.ksp.getIterationNumber() > self.refactor_after_its)
                      or _relative_change(A, P) > self.jacobian_change_tol)
             if fresh:
                 jacobian(x, P)
@@ -284,16 +285,27 @@ class NonlinearSolver:
     def solve(self) -> int:
         """Solve from the current value of u (warm start); returns Newton iterations."""
         start = time.perf_counter()
+        x = compat.petsc_vec(self.u)
+        guess = x.copy()  # the callbacks write trial iterates into u: keep the start
         try:
-            its = self.snes.solve(compat.petsc_vec(self.u))
+            its = self.snes.solve(x)
         except ConvergenceError:
+            self._restore(guess)
             if not self.refactor_after_its:
                 raise
             self._force_fresh = True  # the lagged preconditioner may be to blame: retry once
-            its = self.snes.solve(compat.petsc_vec(self.u))
+            try:
+                its = self.snes.solve(x)
+            except ConvergenceError:
+                self._restore(guess)
+                raise
         self.u.x.scatter_forward()
         self.timings["solve"] += time.perf_counter() - start
         return its
+
+    def _restore(self, guess):
+        guess.copy(compat.petsc_vec(self.u))
+        self.u.x.scatter_forward()
 
     @property
     def iterations(self):

@@ -59,16 +59,21 @@ class ArchGeometry(Geometry):
     load_surface: str = "extrados"    # "extrados" or "road" (with fill)
     options: dict = field(default_factory=dict)
 
+    def polar(self, x: np.ndarray):
+        """(r, theta) of points x (N, >=2) about the centre, theta in (-pi/2, 3pi/2] so that
+        both springings (theta ~ 0 and ~ pi, whatever the sign of round-off) are continuous."""
+        d = x[:, :2] - np.asarray(self.centre)
+        theta = np.arctan2(d[:, 1], d[:, 0])
+        return np.hypot(d[:, 0], d[:, 1]), np.where(theta <= -np.pi / 2, theta + 2 * np.pi, theta)
+
     def section_index(self, x: np.ndarray) -> np.ndarray:
         """Nearest section j = round((theta_left - theta)/dtheta) of points x (N, >=2)."""
-        theta = np.arctan2(x[:, 1] - self.centre[1], x[:, 0] - self.centre[0])
+        _, theta = self.polar(x)
         return np.rint((self.theta_left - theta) / self.dtheta).astype(np.int64)
 
     def in_ring(self, x: np.ndarray, tol: float = 1e-8) -> np.ndarray:
         """Mask of the points of x (N, >=2) that lie in the ring (closed)."""
-        d = x[:, :2] - np.asarray(self.centre)
-        r = np.hypot(d[:, 0], d[:, 1])
-        theta = np.arctan2(d[:, 1], d[:, 0])
+        r, theta = self.polar(x)
         t = tol * self.r_out
         return ((r >= self.r_in - t) & (r <= self.r_out + t)
                 & (theta <= self.theta_left + tol) & (theta >= self.theta_left
@@ -213,7 +218,8 @@ def _build_model(geo: ArchGeometry, diagonal, fill, cover, abutments, abutment_h
             g.mesh.setTransfiniteCurve(arc_in[i], n_j + 1)
             g.mesh.setTransfiniteCurve(arc_out[i], n_j + 1)
             g.mesh.setTransfiniteSurface(s, diagonal, [p_in[i], p_in[i + 1], p_out[i + 1], p_out[i]])
-        ext_patch = [arc_out[breaks.index(ja)]]
+        ext_patch = [arc_out[i] for i in range(len(breaks) - 1)
+                     if ja <= breaks[i] and breaks[i + 1] <= jb]
     elif not fill:
         lo = _angle_at_x(geo, geo.r_out, geo.x_load + geo.load_half_width)
         hi = _angle_at_x(geo, geo.r_out, geo.x_load - geo.load_half_width)

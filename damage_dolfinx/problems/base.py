@@ -1,7 +1,7 @@
 """What every problem's time stepper shares: data, state, scalars for the history."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Optional, Union
 
 import numpy as np
@@ -28,6 +28,7 @@ class ProblemData:
     body_force: Optional[LoadBuilder] = None
     traction: Optional[LoadBuilder] = None
     zeta0: Union[float, Callable] = 1.0
+    builders: dict = field(default_factory=dict)  # problem-specific UFL builders, e.g. g(x)
 
 
 class TimeStepper:

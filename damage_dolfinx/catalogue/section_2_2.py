@@ -1,0 +1,83 @@
+"""Catalogue entries of thesis Section 2.2 (quasistatic Kelvin-Voigt body, bilateral contact,
+Tresca friction, damage inclusion with variant A)."""
+import math
+
+import ufl
+
+from ..examples import Example, Figure
+from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from ..parameters import ModelParameters
+
+#: G8: Uzawa step from a log-spaced sweep at n = 16, k = 0.01, T = 1 (rho = 1, 10, 100 all give
+#: 2 iterations per step and the Newton solution to 2e-14; rho = 0.01 needs 25 per step)
+RHO_UZAWA = 10.0
+#: Bermudez-Moreno omega from the same sweep: omega = 100, 300, 1000 give 50, 31, 86 iterations
+#: per step and 4.6e-7, 2.5e-6, 1.0e-5 relative V-distance to Newton at tol 1e-6
+OMEGA_PD = 100.0
+
+
+def _params(g_fric, solver="newton"):
+    return ModelParameters(
+        E=5000.0, nu=0.3, kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.1,
+        lam_u=1000.0, lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False,
+        extra={"m_visc": 100.0, "g_fric": g_fric, "eps_reg": 1e-9, "friction_solver": solver,
+               "rho_uzawa": RHO_UZAWA, "omega_pd": OMEGA_PD, "friction_tol": 1e-6})
+
+
+def examples():
+    from ..geometries.rectangle import rectangle, side
+    from ..problems.kelvin_voigt_2_2 import KelvinVoigtTresca
+
+    common = [
+        "G6: kappa = 1e-2 (missing in the thesis)",
+        "A = 1e-2 B (m_visc = 100), L_trunc = 1000, variant A, q_star = 1000",
+        "G9: friction solved by Newton on Phi_eps with eps_reg = 1e-9 (warm start; eps "
+        "continuation 1e-2 ... 1e-8 only when the direct solve fails); Uzawa and "
+        "penalty-duality available for comparison (--set friction_solver=...)",
+        "friction functional integrated by the vertex (trapezoidal) rule: a nodal Tresca law, "
+        "identical for the three solvers",
+        "G43: no stop at zeta_star in Section 2.2",
+        "1.9/G37: von Mises of the total stress A eps(v_n) + zeta_n Phi_L(B eps(u_n)), DG0",
+    ]
+    square = lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {  # noqa: E731
+        GAMMA_D: side(0, 0.0), GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)})
+    layout = "G5: Gamma_D = {0}x[0,1], f_N on {1}x[0,1], top free, Gamma_C = [0,1]x{0}"
+    ex1 = Example(
+        id="2.2-ex1", section="2.2",
+        title="unit square, traction (100,0)e^t, Tresca g = 5: friction algorithm comparison",
+        params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
+        make_geometry=square, make_stepper=KelvinVoigtTresca,
+        traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)),
+        assumptions=common + [layout],
+        figures=[Figure("figure_2_10.png", "Example 2.2-1: setting and mesh", kind="mesh"),
+                 Figure("fields_final.png", "Example 2.2-1: von Mises stress and damage")])
+    ex2 = Example(
+        id="2.2-ex2", section="2.2",
+        title="Example 1 physics: convergence study (Table 2.4)",
+        params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
+        make_geometry=square, make_stepper=KelvinVoigtTresca,
+        traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)),
+        assumptions=common + [layout, "G10: nested structured meshes, diagonals right"],
+        figures=[Figure("fields_final.png", "Example 2.2-2: von Mises stress and damage")],
+        convergence=dict(ref_n=256, ref_k=5e-4, n=[8, 16, 32, 64, 128],
+                         k=[0.02, 0.01, 0.005, 0.002, 0.001]))
+    ex3 = Example(
+        id="2.2-ex3", section="2.2",
+        title="stick-slip: square (0,4)^2 between two frictional planes (g = 45 below, 1000 above)",
+        params=_params(45.0), T=5.0, k=0.005, n=40, diameter=4 * math.sqrt(2),
+        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 4), n, n, {
+            GAMMA_C: lambda x: side(1, 0.0)(x) | side(1, 4.0)(x)}),
+        make_stepper=KelvinVoigtTresca,
+        body_force=lambda x, t: ufl.as_vector((100.0 * ufl.sin(math.pi * t / 2.0), 0.0)),
+        builders={"friction_bound": lambda x: ufl.conditional(ufl.lt(x[1], 2.0), 45.0, 1000.0),
+                  "probe": (4.0, 0.0)},
+        assumptions=common + [
+            "G7: n = 40, k = 0.005 (below the 0.02 stability limit)",
+            "Gamma_D empty: the Newton Jacobian of the regularised law (stick nodes) and the "
+            "penalty-duality operator are nonsingular; Uzawa needs Gamma_D and is refused",
+            "probe at x = (4, 0): horizontal displacement and tangential stress sigma_tau "
+            "= (a(v, .) - l)_i . tau_i / m_i (the nodal friction force)"],
+        figures=[Figure("figure_2_12_left.png", "Example 2.2-3: deformed mesh", fields=("zeta",),
+                        amplification=3.0),
+                 Figure("figure_2_13.png", "Example 2.2-3: von Mises stress and damage")])
+    return [ex1, ex2, ex3]

@@ -1,0 +1,332 @@
+"""Second-kind variational inequalities with Tresca friction (velocity step (2.67), increment
+step (2.187), dynamic step (3.94)): three interchangeable solvers of the same discrete problem
+
+    v in V:  a(v, w - v) + j(w) - j(v) >= l(w - v)  for all w in V,
+    j(w) = sum_i m_i g_i |w_tau,i|   (nodal quadrature of int_{Gamma_C} g |w_tau| ds),
+
+where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet conditions).
+
+* :class:`RegularisedNewton` (the main solver): SNES Newton on the regularised law Phi_eps
+  (2.99)-(2.101), a line search on the convex energy 1/2 a(v,v) - l(v) + j_eps(v) (objective),
+  warm start from the previous step at the target eps_reg (1e-9), and an eps continuation
+  (1e-2, 1e-4, ..., target) as fallback when the direct solve fails. Linear solves: MUMPS LU,
+  re-factorised only when the Jacobian changes (i.e. when the stick set changes).
+* :class:`Uzawa` (2.98) with the corrections of G8: lambda_{s+1} = P(lambda_s + rho g v_tau),
+  P(x) = x / max(1, |x|); the unregularised problem (needs Gamma_D: a must be coercive).
+* :class:`PenaltyDuality`: the Bermudez-Moreno iteration on the regularised problem, as in the
+  thesis: Phi_eps(v_tau) = omega v_tau + q, q_{s+1} = (G - omega I)_lambda(v_tau + lambda q_s),
+  lambda omega = 1/2.
+
+Uzawa and penalty-duality factorise their constant matrix once and update nodal multipliers
+with NumPy (no loops over dofs); both stop when ||v_{s+1} - v_s||_V <= tol ||v_{s+1}||_V
+(thesis: tol = 1e-6).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from . import compat
+from .constitutive import eps as strain
+from .contact import F_reg, NODAL_QUADRATURE, Phi_reg, tangent
+from .parameters import InputError
+from .solvers import (DIRECT, NEWTON, ConvergenceError, NonlinearSolver,
+                      SolveContext, set_default_options)
+
+#: enables the lagged factorisation (NonlinearSolver); with a direct KSP it is rebuilt exactly
+#: when the Jacobian changes
+REFACTOR_ITS = 10
+
+SOLVERS = ("newton", "uzawa", "penalty-duality")
+
+
+@dataclass
+class FrictionProblem:
+    """Data of one second-kind VI: the unknown ``v``, bilinear ``a`` (UFL, trial/test of V),
+    linear ``l`` (UFL, test), Dirichlet ``bcs``, friction bound ``g`` (UFL scalar), the contact
+    measure ``dsC`` (ds restricted to Gamma_C) and the solve context."""
+    v: fem.Function
+    a: object
+    l: object
+    bcs: list
+    g: object
+    dsC: object
+    context: SolveContext
+
+    @property
+    def V(self):
+        return self.v.function_space
+
+    @property
+    def msh(self):
+        return self.V.mesh
+
+    def nodal_ds(self):
+        return self.dsC(metadata=NODAL_QUADRATURE)
+
+    def tangent(self):
+        return tangent(ufl.FacetNormal(self.msh))
+
+
+class ContactNodes:
+    """Owned vertices of Gamma_C with their lumped weights m_i, unit tangents tau_i and friction
+    bounds g_i, all from nodal-quadrature boundary integrals (valid on any straight sides)."""
+
+    def __init__(self, problem: FrictionProblem):
+        V, msh = problem.V, problem.msh
+        S = compat.scalar_p1(msh)
+        phi, w = ufl.TestFunction(S), ufl.TestFunction(V)
+        ds = problem.nodal_ds()
+        n_owned = S.dofmap.index_map.size_local
+        m = _assembled(phi * ds)[:n_owned]
+        gm = _assembled(problem.g * phi * ds)[:n_owned]
+        tm = _assembled(ufl.dot(problem.tangent(), w) * ds).reshape(-1, 2)[:n_owned]
+        self.dofs = np.flatnonzero(m > 0)
+        if not np.allclose(S.tabulate_dof_coordinates()[self.dofs],
+                           V.tabulate_dof_coordinates()[self.dofs]):
+            raise RuntimeError("scalar and vector P1 dof numberings differ")  # never seen
+        self.m = m[self.dofs]
+        self.g = gm[self.dofs] / self.m
+        tau = tm[self.dofs] / self.m[:, None]
+        self.tau = tau / np.linalg.norm(tau, axis=1)[:, None]
+
+    def tangential(self, v):
+        """v_tau at the contact nodes (owned)."""
+        return np.einsum("ic,ic->i", v.x.array.reshape(-1, 2)[self.dofs], self.tau)
+
+    def add_tangential_load(self, b: PETSc.Vec, force):
+        """b_i -= m_i force_i tau_i on the owned contact nodes (the nodal integral of force w_tau)."""
+        arr = b.getArray().reshape(-1, 2)  # owned part
+        arr[self.dofs] -= (self.m * force)[:, None] * self.tau
+        b.setArray(arr.reshape(-1))
+
+
+def _assembled(L) -> np.ndarray:
+    """Local array (owned + ghost values summed across ranks) of an assembled linear form."""
+    f = compat.form(L)
+    b = compat.create_vector(f)
+    with b.localForm() as bl:
+        bl.set(0.0)
+    compat.assemble_vector(b, f)
+    b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    with b.localForm() as bl:
+        return bl.array.copy()
+
+
+class ConstantOperator:
+    """A constant matrix assembled and factorised once (options prefix), solving for many
+    right-hand sides."""
+
+    def __init__(self, a, bcs, prefix, context):
+        self.a = compat.form(a)
+        self.A = compat.create_matrix(self.a)
+        compat.assemble_matrix(self.A, self.a, bcs)
+        self.A.assemble()
+        self.prefix, self.context = prefix, context
+        set_default_options(prefix, DIRECT)
+        self.ksp = PETSc.KSP().create(self.A.getComm())
+        self.ksp.setOptionsPrefix(prefix)
+        self.ksp.setOperators(self.A)
+        self.ksp.setFromOptions()
+
+    def solve(self, b, x):
+        self.ksp.solve(b, x)
+        if self.ksp.getConvergedReason() < 0:
+            raise ConvergenceError(
+                f"{self.prefix}ksp failed ({self.ksp.getConvergedReason()}) in example "
+                f"{self.context.example}, step {self.context.step}, t = {self.context.t:.6g}, "
+                f"residual {self.ksp.getResidualNorm():.3e}")
+
+
+class _IterativeFrictionSolver:
+    """Shared part of Uzawa and penalty-duality: rhs l assembled once per step, a constant
+    factorised operator, V-norm increments, the stopping test."""
+
+    name = "?"
+
+    def __init__(self, problem: FrictionProblem, operator_form, prefix, tol=1e-6, max_it=20000):
+        self.p, self.tol, self.max_it = problem, tol, max_it
+        self.nodes = ContactNodes(problem)
+        self.op = ConstantOperator(operator_form, problem.bcs, prefix, problem.context)
+        self.l = compat.form(problem.l)
+        self.b0 = compat.create_vector(self.l)
+        self.b = self.b0.duplicate()
+        V = problem.V
+        u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+        self.K_eps = compat.create_matrix(compat.form(ufl.inner(strain(u), strain(w)) * ufl.dx))
+        compat.assemble_matrix(self.K_eps, compat.form(ufl.inner(strain(u), strain(w)) * ufl.dx), [])
+        self.K_eps.assemble()
+        self.iterations = 0
+        self.solves = 0
+        self.timings = {"solve": 0.0}
+
+    def _v_norm(self, x):
+        y = x.duplicate()
+        self.K_eps.mult(x, y)
+        return math.sqrt(max(x.dot(y), 0.0))
+
+    def solve(self) -> int:
+        start = time.perf_counter()
+        with self.b0.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(self.b0, self.l)
+        self.b0.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self._start()
+        x = compat.petsc_vec(self.p.v)
+        previous = x.copy()
+        for s in range(1, self.max_it + 1):
+            self.b0.copy(self.b)
+            self.nodes.add_tangential_load(self.b, self._multiplier_force())
+            compat.set_bc(self.b, self.p.bcs)
+            self.op.solve(self.b, x)
+            x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+            self._update_multiplier(self.nodes.tangential(self.p.v))
+            previous.axpy(-1.0, x)
+            change, size = self._v_norm(previous), self._v_norm(x)
+            x.copy(previous)
+            if change <= self.tol * max(size, 1e-300):
+                break
+        else:
+            c = self.p.context
+            raise ConvergenceError(f"{self.name} did not converge in {self.max_it} iterations in "
+                                   f"example {c.example}, step {c.step}, t = {c.t:.6g}, relative "
+                                   f"V-change {change / max(size, 1e-300):.3e}")
+        self.iterations += s
+        self.solves += 1
+        self.timings["solve"] += time.perf_counter() - start
+        return s
+
+
+class Uzawa(_IterativeFrictionSolver):
+    """(2.98) with G8: a(v_{s+1}, w) + sum_i m_i g_i lambda_{s,i} w_tau,i = l(w);
+    lambda_{s+1} = P(lambda_s + rho g v_{s+1,tau}), P(x) = x / max(1, |x|). The multiplier is
+    kept between time steps (warm start)."""
+
+    name = "uzawa"
+
+    def __init__(self, problem: FrictionProblem, rho: float, prefix="uzawa_", tol=1e-6, **kw):
+        if not rho > 0:
+            raise InputError(f"Uzawa step rho_U must be positive, got {rho}")
+        super().__init__(problem, problem.a, prefix, tol, **kw)
+        self.rho = rho
+        self.lam = np.zeros(self.nodes.dofs.size)
+
+    def _start(self):
+        pass
+
+    def _multiplier_force(self):
+        return self.nodes.g * self.lam
+
+    def _update_multiplier(self, v_tau):
+        x = self.lam + self.rho * self.nodes.g * v_tau
+        self.lam = x / np.maximum(1.0, np.abs(x))
+
+
+class PenaltyDuality(_IterativeFrictionSolver):
+    """Bermudez-Moreno on the regularised law: a(v, w) + sum_i m_i (omega v_tau,i + q_i) w_tau,i
+    = l(w) with q = (Phi_eps - omega I)_lambda(v_tau + lambda q), lambda = 1/(2 omega)."""
+
+    name = "penalty-duality"
+
+    def __init__(self, problem: FrictionProblem, eps_reg: float, omega: float,
+                 prefix="pd_", tol=1e-6, **kw):
+        if not omega > 0:
+            raise InputError(f"penalty-duality omega must be positive, got {omega}")
+        v, w, tt = ufl.TrialFunction(problem.V), ufl.TestFunction(problem.V), problem.tangent()
+        operator = problem.a + omega * ufl.dot(v, tt) * ufl.dot(w, tt) * problem.nodal_ds()
+        super().__init__(problem, operator, prefix, tol, **kw)
+        self.eps_reg, self.omega = eps_reg, omega
+        self.q = np.zeros(self.nodes.dofs.size)
+
+    def _start(self):
+        pass
+
+    def _multiplier_force(self):
+        return self.q
+
+    def _update_multiplier(self, v_tau):
+        """q = 2 omega (x - y) with y + Phi_eps(y)/omega = 2x, x = v_tau + q/(2 omega)."""
+        g, eps_, om = self.nodes.g, self.eps_reg, self.omega
+        x = v_tau + self.q / (2.0 * om)
+        stick = np.abs(2.0 * x) <= eps_ + g / om
+        y = np.where(stick, 2.0 * x / (1.0 + g / (om * eps_)), 2.0 * x - np.sign(x) * g / om)
+        self.q = 2.0 * om * (x - y)
+
+
+#: SNES defaults of the friction Newton: line search on the convex energy (objective)
+FRICTION_NEWTON = {**NEWTON, "snes_linesearch_type": "bt", "snes_max_it": 100,
+                   "snes_rtol": 1e-10, "snes_atol": 1e-11, "snes_stol": 1e-14}
+
+
+class RegularisedNewton:
+    """Newton on the regularised optimality equation (2.99)-(2.101):
+    a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9)."""
+
+    name = "newton"
+
+    def __init__(self, problem: FrictionProblem, eps_reg=1e-9, prefix="friction_",
+                 continuation=(1e-2, 1e-4, 1e-6, 1e-8)):
+        msh, v = problem.msh, problem.v
+        self.p, self.target = problem, float(eps_reg)
+        self.continuation = [e for e in continuation if e > self.target] + [self.target]
+        self.eps = fem.Constant(msh, self.target)
+        w, tt, ds = ufl.TestFunction(problem.V), problem.tangent(), problem.nodal_ds()
+        v_tau = ufl.dot(v, tt)
+        F = ufl.action(problem.a, v) - problem.l + Phi_reg(v_tau, problem.g, self.eps) * ufl.dot(w, tt) * ds
+        J = ufl.derivative(F, v, ufl.TrialFunction(problem.V))
+        energy = (0.5 * ufl.action(ufl.action(problem.a, v), v) - ufl.action(problem.l, v)
+                  + F_reg(v_tau, problem.g, self.eps) * ds)
+        self._energy = compat.form(energy)
+        self.newton = NonlinearSolver(F, v, problem.bcs, prefix, problem.context,
+                                      defaults=FRICTION_NEWTON,
+                                      refactor_after_its=REFACTOR_ITS)
+        self.snes = self.newton.snes
+        self.snes.snes.setObjective(self._objective)
+        self.iterations = 0
+        self.solves = 0
+        self.continuations = 0
+        self.timings = {"solve": 0.0}
+
+    def _objective(self, snes, x):
+        x.copy(compat.petsc_vec(self.p.v))
+        self.p.v.x.scatter_forward()
+        return compat.assemble_scalar(self._energy, self.p.msh.comm)
+
+    def solve(self) -> int:
+        """Warm start at the target eps; on failure restart from the step's initial guess with
+        eps continuation. Returns the Newton iterations of this step."""
+        start = time.perf_counter()
+        before = self.snes.iterations
+        try:
+            self.eps.value = self.target
+            self.newton.solve()  # from the previous step's velocity
+        except ConvergenceError:
+            self.continuations += 1  # unchanged v: restart with eps continuation
+            for e in self.continuation:
+                self.eps.value = e
+                self.newton.solve()
+        its = self.snes.iterations - before
+        self.iterations += its
+        self.solves += 1
+        self.timings["solve"] += time.perf_counter() - start
+        return its
+
+
+def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: float,
+                omega_pd: float, tol: float = 1e-6):
+    """The friction solver selected by ``kind`` (newton | uzawa | penalty-duality)."""
+    if kind == "newton":
+        return RegularisedNewton(problem, eps_reg)
+    if kind == "uzawa":
+        return Uzawa(problem, rho_uzawa, tol=tol)
+    if kind == "penalty-duality":
+        return PenaltyDuality(problem, eps_reg, omega_pd, tol=tol)
+    raise InputError(f"unknown friction solver {kind!r}; choose one of {', '.join(SOLVERS)}")
