@@ -251,10 +251,11 @@ class NonlinearSolver:
     """
 
     def __init__(self, F, u, bcs, prefix: str, context: SolveContext, defaults=None,
-                 refactor_after_its=None):
+                 refactor_after_its=None, J=None):
         import ufl
         self.u = u
-        J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
+        if J is None:
+            J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
         residual, jacobian, b, A = form_callbacks(F, J, u, bcs)
         if defaults is None:
             defaults = NEWTON_LAGGED if refactor_after_its else NEWTON

@@ -140,4 +140,5 @@ class KelvinVoigtTresca(TimeStepper):
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations, "friction": self.friction.iterations,
                 "friction_solver": self.friction.name,
-                "friction_continuations": getattr(self.friction, "continuations", 0)}
+                "friction_continuations": getattr(self.friction, "continuations", 0),
+                "friction_shifted_continuations": getattr(self.friction, "shifted_continuations", 0)}
