@@ -46,8 +46,11 @@ class Progress:
 
 
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
-        write_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
-    """Run one catalogue example and write its outputs to ``out``; returns the summary."""
+        write_every=None, progress=True, figures=True, time_limit=None,
+        comm=MPI.COMM_WORLD) -> dict:
+    """Run one catalogue example and write its outputs to ``out``; returns the summary.
+    With ``time_limit`` (seconds) the run stops after the step that exceeds it, with status
+    "time_limit" (used by benchmarks that skip cells a solver cannot finish)."""
     wall_start = time.perf_counter()
     ex = examples.get(example_id)
     params, grid, n, h, mesh_file = ex.configure(n, k, T, h, overrides, mesh_file)
@@ -96,6 +99,8 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
             stats = stepper.advance()
             scalars = record(stats, time.perf_counter() - start)
             stop = stepper.stop_reason()
+            if time_limit and comm.allreduce(time.perf_counter() - wall_start, op=MPI.MAX) > time_limit:
+                stop = stop or "time_limit"
             if stop or stepper.n % write_every == 0 or stepper.n == N:
                 write_fields()
             report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
