@@ -21,6 +21,7 @@ class Figure:
     fields: tuple = ("von_mises", "zeta")
     amplification: Optional[float] = None  # None: largest displacement = 10% of diameter (G40)
     kind: str = "fields"                   # "fields" (final state) or "mesh" (setting and mesh)
+    times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
 
 
 @dataclass

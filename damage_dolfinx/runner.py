@@ -88,11 +88,20 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         xdmf.write(stepper.output_fields, stepper.t)
         io.write_json(out / "summary.json", summary, comm)
 
+    def timed_figures():
+        """Figures requested at the current time (Figure.times)."""
+        for fig in ex.figures if figures else []:
+            if any(abs(stepper.t - t) < 0.5 * grid.k for t in fig.times):
+                stepper.update_output()
+                summary["outputs"]["figures"].append(
+                    draw_figure(ex, fig, stepper, out, suffix=f"_t{stepper.t:g}"))
+
     try:
         start = time.perf_counter()
         stats = stepper.initialize()
         scalars = record(stats, time.perf_counter() - start)
         write_fields()
+        timed_figures()
         report(0, 0.0, stats, scalars, force=True)
         while stepper.n < N:
             start = time.perf_counter()
@@ -103,6 +112,7 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                 stop = stop or "time_limit"
             if stop or stepper.n % write_every == 0 or stepper.n == N:
                 write_fields()
+            timed_figures()
             report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
             if stop:
                 summary["status"] = stop
@@ -119,7 +129,9 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     io.save_final_fields(out / "fields_final.npz",
                          {"u": stepper.u, "zeta": stepper.zeta, "von_mises": stepper.von_mises})
     if figures:
-        summary["outputs"]["figures"] = write_figures(ex, stepper, out)
+        stepper.update_output()
+        summary["outputs"]["figures"] += [draw_figure(ex, fig, stepper, out)
+                                          for fig in ex.figures if not fig.times]
     summary["timings_s"] = dict(getattr(stepper, "timings", {}))
     summary["wall_time_s"] = time.perf_counter() - wall_start
     io.write_json(out / "summary.json", summary, comm)
@@ -138,21 +150,17 @@ def auto_amplification(stepper, diameter) -> float:
     return 0.1 * diameter / umax if umax > 0 else 1.0
 
 
-def write_figures(ex, stepper, out: Path) -> list:
-    """The example's figures (PNG) at the final state; returns their file names."""
-    names = []
+def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
+    """One catalogue figure (PNG) of the current state; returns its file entry."""
+    filename = fig.filename.replace(".png", f"{suffix}.png")
+    if fig.kind == "mesh":
+        post.plot_mesh(stepper.data.geometry, out / filename, title=fig.title,
+                       labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",
+                               GAMMA_C: "Gamma_C (contact)"})
+        return {"file": filename}
     fields = {"von_mises": (stepper.von_mises, "von Mises stress [Pa]"),
               "zeta": (stepper.zeta, "damage zeta [-]")}
-    for fig in ex.figures:
-        if fig.kind == "mesh":
-            post.plot_mesh(stepper.data.geometry, out / fig.filename, title=fig.title,
-                           labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",
-                                   GAMMA_C: "Gamma_C (contact)"})
-            names.append({"file": fig.filename})
-            continue
-        amp = fig.amplification or auto_amplification(stepper, ex.diameter)
-        post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / fig.filename,
-                         amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})",
-                         outline=True)
-        names.append({"file": fig.filename, "amplification": amp})
-    return names
+    amp = fig.amplification or auto_amplification(stepper, ex.diameter)
+    post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / filename,
+                     amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True)
+    return {"file": filename, "t": stepper.t, "amplification": amp}

@@ -27,6 +27,8 @@ def examples():
         "u_0 from the contact problem at t = 0 without memory (Remark 2.3)",
         "G43: no stop at zeta_star in Section 2.3 (flag stop_at_zeta_star off)",
         "1.9/G37: von Mises of the total stress B eps(u_n) + M_n, cell-wise (DG0)",
+        "G40: fixed displacement factors (x3 Ex. 2, x2 Ex. 3) so that the figures at different "
+        "times compare",
     ]
     ex1 = Example(
         id="2.3-ex1", section="2.3",
@@ -53,7 +55,10 @@ def examples():
         assumptions=common + ["G13: Omega = (0,3)x(0,2), load (-30,0) on {3}x[0,2], mesh 30x20 "
                               "(--n 10 = 10 cells per unit length), k = 0.01"],
         figures=[Figure("figure_2_16.png", "Example 2.3-2: setting and mesh", kind="mesh"),
-                 Figure("figure_2_17_18.png", "Example 2.3-2: von Mises stress and damage")])
+                 Figure("figure_2_17.png", "Example 2.3-2: von Mises stress", fields=("von_mises",),
+                        amplification=3.0, times=(0.0, 2.0)),
+                 Figure("figure_2_18.png", "Example 2.3-2: damage", fields=("zeta",),
+                        amplification=3.0)])
     ex3 = Example(
         id="2.3-ex3", section="2.3",
         title="cantilever (0,4)x(0,1) on a foundation, load (0,-10) removed at t = 0.5, fading memory",
@@ -67,5 +72,8 @@ def examples():
                               "kernel G = -zeta exp(-(t-s)) Phi_L(B eps): recursive update",
                               "load (0,-10) for t <= 0.5 (t_n = 0.5 included), 0 afterwards"],
         figures=[Figure("figure_2_19.png", "Example 2.3-3: setting and mesh", kind="mesh"),
-                 Figure("figure_2_21.png", "Example 2.3-3: von Mises stress and damage")])
+                 Figure("figure_2_20.png", "Example 2.3-3: von Mises stress", fields=("von_mises",),
+                        amplification=2.0, times=(0.0, 0.5)),
+                 Figure("figure_2_21.png", "Example 2.3-3: von Mises stress and damage",
+                        amplification=2.0)])
     return [ex1, ex2, ex3]
