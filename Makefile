@@ -18,7 +18,7 @@ APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl pyth
     python3-venv python3-setuptools gcc
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: setup system-deps demo test test-serial test-mpi bench convergence clean
+.PHONY: setup system-deps demo test bench convergence clean
 
 setup: $(VENV)/.installed
 
@@ -51,6 +51,10 @@ test: setup
 
 bench: setup
 	$(MPIRUN) $(PY) benchmarks/step_timing_2_1.py
+	$(PY) benchmarks/memory_cost_2_3.py
+	$(PY) benchmarks/friction_cpu_2_2.py
+	$(MPIRUN) $(PY) benchmarks/bridge_collapse.py
+	$(PY) benchmarks/bridge_sensitivity.py
 
 convergence: setup
 	$(MPIRUN) $(PY) benchmarks/convergence.py 2.1-ex1
