@@ -20,7 +20,8 @@ class Figure:
     title: str
     fields: tuple = ("von_mises", "zeta")
     amplification: Optional[float] = None  # None: largest displacement = 10% of diameter (G40)
-    kind: str = "fields"                   # "fields" (final state) or "mesh" (setting and mesh)
+    kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh) or
+    #                                        "history" (fields = ((column, label), ...) of history.csv)
     times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
 
 

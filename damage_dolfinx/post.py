@@ -185,3 +185,25 @@ def loglog_rate(x, y):
     if ok.sum() < 2:
         return float("nan")
     return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0])
+
+
+def plot_history(csv_path, columns, path, title=""):
+    """Time histories of history.csv columns, one axis each (rank 0 only)."""
+    import csv
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    with open(csv_path) as f:
+        rows = list(csv.DictReader(f))
+    t = np.array([float(r["t"]) for r in rows])
+    fig, axes = plt.subplots(len(columns), 1, figsize=(6.4, 2.6 * len(columns)), sharex=True,
+                             squeeze=False)
+    for ax, (column, label) in zip(axes[:, 0], columns):
+        ax.plot(t, [float(r[column]) if r[column] else np.nan for r in rows], lw=1.2)
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    axes[-1, 0].set_xlabel("t [s]")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)

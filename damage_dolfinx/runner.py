@@ -153,6 +153,10 @@ def auto_amplification(stepper, diameter) -> float:
 def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
     """One catalogue figure (PNG) of the current state; returns its file entry."""
     filename = fig.filename.replace(".png", f"{suffix}.png")
+    if fig.kind == "history":  # history.csv is complete and flushed at the end of the run
+        if stepper.comm.rank == 0:
+            post.plot_history(out / "history.csv", fig.fields, out / filename, title=fig.title)
+        return {"file": filename}
     if fig.kind == "mesh":
         post.plot_mesh(stepper.data.geometry, out / filename, title=fig.title,
                        labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",

@@ -80,5 +80,8 @@ def examples():
             "= (a(v, .) - l)_i . tau_i / m_i (the nodal friction force)"],
         figures=[Figure("figure_2_12_left.png", "Example 2.2-3: deformed mesh", fields=("zeta",),
                         amplification=3.0),
+                 Figure("figure_2_12_right.png", "Example 2.2-3: history at x = (4, 0)",
+                        kind="history", fields=(("probe_u1", "u_1(4, 0) [m]"),
+                                                ("probe_sigma_tau", "sigma_tau(4, 0) [Pa]"))),
                  Figure("figure_2_13.png", "Example 2.2-3: von Mises stress and damage")])
     return [ex1, ex2, ex3]
