@@ -295,18 +295,45 @@ class RegularisedNewton:
         self.shift = fem.Constant(msh, 0.0)
         J = (ufl.derivative(F, v, dv)
              + self.shift * problem.g * ufl.dot(dv, tt) * ufl.dot(w, tt) * ds)
-        energy = (0.5 * ufl.action(ufl.action(problem.a, v), v) - ufl.action(problem.l, v)
-                  + F_reg(v_tau, problem.g, self.eps) * ds)
+        # objective: the energy relative to the solve's starting point v0, written without
+        # cancellation, E(v) - E(v0) = 1/2 a(v + v0, v - v0) - l(v - v0) + j_eps(v) - j_eps(v0):
+        # the line search then resolves decreases relative to |v - v0|, not to |E| (which the
+        # explicit elastic load makes large)
+        self.v0 = fem.Function(problem.V)
+        d, s_ = v - self.v0, v + self.v0
+        test, trial = sorted(problem.a.arguments(), key=lambda arg: arg.number())
+        energy = (0.5 * ufl.replace(problem.a, {trial: s_, test: d})
+                  - ufl.replace(problem.l, {problem.l.arguments()[0]: d})
+                  + (F_reg(v_tau, problem.g, self.eps)
+                     - F_reg(ufl.dot(self.v0, tt), problem.g, self.eps)) * ds)
         self._energy = compat.form(energy)
         self.newton = NonlinearSolver(F, v, problem.bcs, prefix, problem.context,
                                       defaults=FRICTION_NEWTON,
                                       refactor_after_its=REFACTOR_ITS, J=J)
+        newton_solve = self.newton.solve
+
+        def solve_from_here():
+            self.v0.x.array[:] = v.x.array
+            return newton_solve()
+        self.newton.solve = solve_from_here
         self.snes = self.newton.snes
         self.snes.snes.setObjective(self._objective)
         self.iterations = 0
         self.solves = 0
-        self.continuations = self.shifted_continuations = 0
+        self.continuations = self.shifted_continuations = self.full_step_solves = 0
+        self.prefix = prefix
         self.timings = {"solve": 0.0}
+
+    def _with_line_search(self, kind, fn):
+        opts, key = PETSc.Options(), self.prefix + "snes_linesearch_type"
+        previous = opts.getString(key, "bt")
+        opts[key] = kind
+        self.snes.snes.setFromOptions()
+        try:
+            return fn()
+        finally:
+            opts[key] = previous
+            self.snes.snes.setFromOptions()
 
     def _continuation(self, shifted=False):
         """Solve for eps = 1e-2, 1e-4, ..., target, each from the previous solution; with
@@ -328,7 +355,7 @@ class RegularisedNewton:
     def solve(self) -> int:
         """Newton at the target eps from the previous velocity (backtracking on the energy); on
         failure an eps continuation 1e-2 -> target with warm starts; on failure again the same
-        continuation with the Jacobian shift on its non-final stages.
+        continuation with the Jacobian shift on its non-final stages; last, full Newton steps.
         Returns this step's Newton iterations."""
         start = time.perf_counter()
         before = self.snes.iterations
@@ -340,8 +367,15 @@ class RegularisedNewton:
             try:
                 self._continuation()
             except ConvergenceError:
-                self.shifted_continuations += 1  # last resort: with the Jacobian shift
-                self._continuation(shifted=True)
+                self.shifted_continuations += 1  # with the Jacobian shift
+                try:
+                    self._continuation(shifted=True)
+                except ConvergenceError:
+                    # last resort: full Newton steps at the target eps from the last stage's start
+                    # (the energy line search cannot certify decreases below round-off, which
+                    # near convergence at large |energy| stalls it)
+                    self.full_step_solves += 1
+                    self._with_line_search("basic", self.newton.solve)
         its = self.snes.iterations - before
         self.iterations += its
         self.solves += 1

@@ -141,4 +141,5 @@ class KelvinVoigtTresca(TimeStepper):
         return {"damage_snes": self.damage.iterations, "friction": self.friction.iterations,
                 "friction_solver": self.friction.name,
                 "friction_continuations": getattr(self.friction, "continuations", 0),
-                "friction_shifted_continuations": getattr(self.friction, "shifted_continuations", 0)}
+                "friction_shifted_continuations": getattr(self.friction, "shifted_continuations", 0),
+                "friction_full_step_solves": getattr(self.friction, "full_step_solves", 0)}
