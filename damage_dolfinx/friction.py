@@ -9,7 +9,7 @@ where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet cond
 * :class:`RegularisedNewton` (the main solver): SNES Newton on the regularised law Phi_eps
   (2.99)-(2.101) with a backtracking line search on the convex energy
   1/2 a(v,v) - l(v) + j_eps(v) (SNES objective), warm start from the previous step at the target
-  eps_reg (1e-9); fallbacks: an eps continuation (1e-2, 1e-4, ..., target), then the same
+  eps_reg (1e-9); fallbacks: an eps continuation (1e-2, 1e-3, ..., target), then the same
   continuation with a Jacobian shift (needed when no Gamma_D holds the body). Linear solves: MUMPS LU,
   re-factorised only when the Jacobian changes (i.e. when the stick set changes).
 * :class:`Uzawa` (2.98) with the corrections of G8: lambda_{s+1} = P(lambda_s + rho g v_tau),
@@ -278,7 +278,7 @@ class RegularisedNewton:
     name = "newton"
 
     def __init__(self, problem: FrictionProblem, eps_reg=1e-9, prefix="friction_",
-                 continuation=(1e-2, 1e-4, 1e-6, 1e-8)):
+                 continuation=(1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)):
         msh, v = problem.msh, problem.v
         self.p, self.target = problem, float(eps_reg)
         self.continuation = [e for e in continuation if e > self.target] + [self.target]
@@ -354,7 +354,7 @@ class RegularisedNewton:
 
     def solve(self) -> int:
         """Newton at the target eps from the previous velocity (backtracking on the energy); on
-        failure an eps continuation 1e-2 -> target with warm starts; on failure again the same
+        failure an eps continuation 1e-2, 1e-3, ... -> target with warm starts; on failure again the same
         continuation with the Jacobian shift on its non-final stages; last, full Newton steps.
         Returns this step's Newton iterations."""
         start = time.perf_counter()

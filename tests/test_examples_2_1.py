@@ -18,6 +18,7 @@ def test_example1_serial_equals_two_ranks(tmp_path):
     assert p_sum["mpi_size"] == 2 and s_sum["mpi_size"] == 1
     for name in ("u", "zeta", "von_mises"):
         assert np.allclose(s[name + "_coords"], p[name + "_coords"], atol=1e-12)
+        print(f"{name}: serial vs 2 ranks relative difference {rel_diff(p[name], s[name]):.2e}")
         assert rel_diff(p[name], s[name]) < 1e-8, name
     for key in ("u_L2", "eps_u_L2", "zeta_min", "zeta_max"):
         assert p_sum["final"][key] == pytest.approx(s_sum["final"][key], rel=1e-8)
