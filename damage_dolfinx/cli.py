@@ -25,6 +25,8 @@ def _parser():
                         help="override a model parameter, e.g. --set kappa=0.01 (repeatable)")
         sp.add_argument("--out", required=True, help="output folder")
         sp.add_argument("--quiet", action="store_true", help="no progress lines")
+        sp.add_argument("--friction-solver", choices=("newton", "uzawa", "penalty-duality"),
+                        help="Tresca solver of Sections 2.2/2.4/3.2 (same as --set friction_solver=...)")
 
     run = sub.add_parser("run", help="run one example", allow_abbrev=False)
     common(run)
@@ -71,9 +73,9 @@ def _is_option(tok):
         return True
 
 
-def _overrides(pairs):
+def _overrides(pairs, friction_solver=None):
     from .parameters import InputError
-    out = {}
+    out = {} if friction_solver is None else {"friction_solver": friction_solver}
     for pair in pairs:
         if "=" not in pair:
             raise InputError(f"--set expects NAME=VALUE, got {pair!r}")
@@ -100,14 +102,14 @@ def main(argv=None):
         if args.command == "run":
             from . import runner
             runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
-                       overrides=_overrides(args.set), mesh_file=args.mesh,
+                       overrides=_overrides(args.set, args.friction_solver), mesh_file=args.mesh,
                        write_every=args.write_every, progress=not args.quiet,
                        figures=not args.no_figures)
             return 0
         if args.command == "converge":
             from . import convergence
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
-                              ns=args.n, ks=args.k, T=args.T, overrides=_overrides(args.set),
+                              ns=args.n, ks=args.k, T=args.T, overrides=_overrides(args.set, args.friction_solver),
                               progress=not args.quiet)
             return 0
     except InputError as exc:
