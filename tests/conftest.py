@@ -38,3 +38,18 @@ def unit_square():
     from mpi4py import MPI
     from damage_dolfinx import compat
     return lambda n: compat.create_rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), (n, n))
+
+
+def serial_and_two_ranks(tmp_path, args, fields=("u", "zeta", "von_mises"), tol=1e-8):
+    """Run ``args`` serially and on 2 ranks; assert the final fields agree to ``tol``
+    (relative) and return ((serial summary, fields), (parallel summary, fields))."""
+    run_cli(list(args) + ["--out", tmp_path / "s"])
+    run_cli(list(args) + ["--out", tmp_path / "p"], np_=2)
+    serial, parallel = load_run(tmp_path / "s"), load_run(tmp_path / "p")
+    assert serial[0]["mpi_size"] == 1 and parallel[0]["mpi_size"] == 2
+    for name in fields:
+        assert np.allclose(serial[1][name + "_coords"], parallel[1][name + "_coords"], atol=1e-12)
+        diff = rel_diff(parallel[1][name], serial[1][name])
+        print(f"{name}: serial vs 2 ranks relative difference {diff:.2e}")
+        assert diff < tol, name
+    return serial, parallel

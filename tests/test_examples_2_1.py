@@ -6,20 +6,13 @@ import json
 import numpy as np
 import pytest
 
-from conftest import load_run, rel_diff, run_cli
+from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 
 
 @pytest.mark.mpi
 def test_example1_serial_equals_two_ranks(tmp_path):
-    args = ["run", "2.1-ex1", "--n", "10", "--k", "0.05", "--no-figures", "--quiet"]
-    run_cli(args + ["--out", tmp_path / "s"])
-    run_cli(args + ["--out", tmp_path / "p"], np_=2)
-    (s_sum, s), (p_sum, p) = load_run(tmp_path / "s"), load_run(tmp_path / "p")
-    assert p_sum["mpi_size"] == 2 and s_sum["mpi_size"] == 1
-    for name in ("u", "zeta", "von_mises"):
-        assert np.allclose(s[name + "_coords"], p[name + "_coords"], atol=1e-12)
-        print(f"{name}: serial vs 2 ranks relative difference {rel_diff(p[name], s[name]):.2e}")
-        assert rel_diff(p[name], s[name]) < 1e-8, name
+    (s_sum, _), (p_sum, _) = serial_and_two_ranks(
+        tmp_path, ["run", "2.1-ex1", "--n", "10", "--k", "0.05", "--no-figures", "--quiet"])
     for key in ("u_L2", "eps_u_L2", "zeta_min", "zeta_max"):
         assert p_sum["final"][key] == pytest.approx(s_sum["final"][key], rel=1e-8)
     # the run really damaged the body, and the history has every step

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from mpi4py import MPI
 
-from conftest import load_run, rel_diff, run_cli
+from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
 from damage_dolfinx.geometries.rectangle import rectangle, side
 from damage_dolfinx.parameters import ModelParameters, TimeGrid
@@ -69,13 +69,8 @@ def test_memory_mode_must_match_kernel(tmp_path):
 
 @pytest.mark.mpi
 def test_example1_serial_equals_two_ranks(tmp_path):
-    args = ["run", "2.3-ex1", "--n", "8", "--k", "0.05", "--no-figures", "--quiet"]
-    run_cli(args + ["--out", tmp_path / "s"])
-    run_cli(args + ["--out", tmp_path / "p"], np_=2)
-    (_, s), (p_sum, p) = load_run(tmp_path / "s"), load_run(tmp_path / "p")
-    assert p_sum["mpi_size"] == 2
-    for name in ("u", "zeta", "von_mises"):
-        assert rel_diff(p[name], s[name]) < 1e-8, name
+    serial_and_two_ranks(tmp_path, ["run", "2.3-ex1", "--n", "8", "--k", "0.05", "--no-figures",
+                                    "--quiet"])
 
 
 def history(folder):

@@ -43,22 +43,19 @@ def examples():
     square = lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {  # noqa: E731
         GAMMA_D: side(0, 0.0), GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)})
     layout = "G5: Gamma_D = {0}x[0,1], f_N on {1}x[0,1], top free, Gamma_C = [0,1]x{0}"
+    test1 = dict(params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),  # Ex. 1-2
+                 make_geometry=square, make_stepper=KelvinVoigtTresca,
+                 traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)))
     ex1 = Example(
         id="2.2-ex1", section="2.2",
         title="unit square, traction (100,0)e^t, Tresca g = 5: friction algorithm comparison",
-        params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
-        make_geometry=square, make_stepper=KelvinVoigtTresca,
-        traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)),
-        assumptions=common + [layout],
+        **test1, assumptions=common + [layout],
         figures=[Figure("figure_2_10.png", "Example 2.2-1: setting and mesh", kind="mesh"),
                  Figure("fields_final.png", "Example 2.2-1: von Mises stress and damage")])
     ex2 = Example(
         id="2.2-ex2", section="2.2",
         title="Example 1 physics: convergence study (Table 2.4)",
-        params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
-        make_geometry=square, make_stepper=KelvinVoigtTresca,
-        traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)),
-        assumptions=common + [layout, "G10: nested structured meshes, diagonals right"],
+        **test1, assumptions=common + [layout, "G10: nested structured meshes, diagonals right"],
         figures=[Figure("fields_final.png", "Example 2.2-2: von Mises stress and damage")],
         convergence=dict(ref_n=256, ref_k=5e-4, n=[8, 16, 32, 64, 128],
                          k=[0.02, 0.01, 0.005, 0.002, 0.001]))

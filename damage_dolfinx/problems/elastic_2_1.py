@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 import ufl
 from dolfinx import fem
 
 from .. import compat
 from ..damage import DamageStep, source
 from ..forms.elastic_damage import equilibrium_forms, stress
+from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from damage_dolfinx.geometries import GAMMA_D, GAMMA_N
 from ..solvers import LAGGED_DIRECT, LinearSolver
@@ -52,15 +52,12 @@ class ElasticDamage(TimeStepper):
 
         # (2.21): elasticity with the new damage zeta_n
         tags = data.geometry.facet_tags
-        msh.topology.create_connectivity(1, 2)
         dsN = ufl.Measure("ds", domain=msh, subdomain_data=tags)(GAMMA_N)
         w = ufl.TestFunction(V)
         f_B, f_N = self.loads()
         a, L = equilibrium_forms(ufl.TrialFunction(V), w, self.zeta, p.E, p.nu, p.zeta_star,
                                  f_B, f_N, dsN)
-        clamped = tags.indices[tags.values == GAMMA_D]
-        zero = np.zeros(2, dtype=compat.ScalarType)
-        bc = fem.dirichletbc(zero, fem.locate_dofs_topological(V, 1, clamped), V)
+        bc = clamped(V, tags, GAMMA_D)
         self.mech = LinearSolver(a, L, [bc], mech_prefix, self.context, defaults=LAGGED_DIRECT,
                                  refactor_after_its=MECH_REFACTOR_ITS)
 

@@ -21,6 +21,7 @@ from dolfinx import fem
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from .. import compat
+from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from ..damage import DamageStep, source
 from ..forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
@@ -63,16 +64,13 @@ class ViscoelasticMemoryContact(TimeStepper):
 
         # (2.137): nonlinear displacement step
         tags = data.geometry.facet_tags
-        msh.topology.create_connectivity(1, 2)
         ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
         self.n_facet = ufl.FacetNormal(msh)
         f_B, f_N = self.loads()
         F = displacement_residual(self.u, ufl.TestFunction(V), self.memory.M, p.E, p.nu,
                                   self.c_nu, self.gap, self.n_facet, f_B, f_N, ds(GAMMA_N),
                                   ds(GAMMA_C))
-        clamped = tags.indices[tags.values == GAMMA_D]
-        bc = fem.dirichletbc(np.zeros(2, dtype=compat.ScalarType),
-                             fem.locate_dofs_topological(V, 1, clamped), V)
+        bc = clamped(V, tags, GAMMA_D)
         self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
                                     refactor_after_its=MECH_REFACTOR_ITS)
 
