@@ -299,6 +299,7 @@ class RegularisedNewton:
         # cancellation, E(v) - E(v0) = 1/2 a(v + v0, v - v0) - l(v - v0) + j_eps(v) - j_eps(v0):
         # the line search then resolves decreases relative to |v - v0|, not to |E| (which the
         # explicit elastic load makes large)
+        self.nodes = ContactNodes(problem)
         self.v0 = fem.Function(problem.V)
         d, s_ = v - self.v0, v + self.v0
         test, trial = sorted(problem.a.arguments(), key=lambda arg: arg.number())
@@ -309,7 +310,8 @@ class RegularisedNewton:
         self._energy = compat.form(energy)
         self.newton = NonlinearSolver(F, v, problem.bcs, prefix, problem.context,
                                       defaults=FRICTION_NEWTON,
-                                      refactor_after_its=REFACTOR_ITS, J=J)
+                                      refactor_after_its=REFACTOR_ITS, J=J,
+                                      jacobian_key=self._stick_set)
         newton_solve = self.newton.solve
 
         def solve_from_here():
@@ -334,6 +336,13 @@ class RegularisedNewton:
         finally:
             opts[key] = previous
             self.snes.snes.setFromOptions()
+
+    def _stick_set(self, x):
+        """What the Jacobian depends on besides constants: eps, the shift and the nodes with
+        |v_tau| <= eps (nodal quadrature), read from the SNES iterate x."""
+        v = x.getArray().reshape(-1, 2)[self.nodes.dofs]
+        stick = np.abs(np.einsum("ic,ic->i", v, self.nodes.tau)) <= self.eps.value
+        return np.concatenate([[float(self.eps.value), float(self.shift.value)], stick])
 
     def _continuation(self, shifted=False):
         """Solve for eps = 1e-2, 1e-4, ..., target, each from the previous solution; with

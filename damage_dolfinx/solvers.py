@@ -11,6 +11,8 @@ import time
 from collections import defaultdict
 from dataclasses import dataclass
 
+import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
@@ -247,13 +249,16 @@ class NonlinearSolver:
     stays exact (the linear systems are solved to rtol 1e-12, or directly with ``preonly`` when
     the factorised matrix equals the Jacobian), the factorisations become rare. The lag works
     through a separate preconditioning matrix P: PETSc re-factorises only when P changes, and P
-    is refreshed (re-assembled as the current Jacobian) only when needed.
+    is refreshed (re-assembled as the current Jacobian) only when needed. With
+    ``jacobian_key(x)`` (a local array on which the Jacobian alone depends, e.g. the stick set
+    and eps), even the assembly is skipped while the key is unchanged.
     """
 
     def __init__(self, F, u, bcs, prefix: str, context: SolveContext, defaults=None,
-                 refactor_after_its=None, J=None):
+                 refactor_after_its=None, J=None, jacobian_key=None):
         import ufl
         self.u = u
+        self.jacobian_key, self._last_key = jacobian_key, None
         if J is None:
             J = ufl.derivative(F, u, ufl.TrialFunction(u.function_space))
         residual, jacobian, b, A = form_callbacks(F, J, u, bcs)
@@ -272,6 +277,8 @@ class NonlinearSolver:
 
     def _lagged(self, jacobian):
         def lagged_jacobian(x, A, P):
+            if self.jacobian_key is not None and self._same_key(x) and not self._force_fresh:
+                return  # the Jacobian depends only on the key (e.g. a stick set): unchanged
             jacobian(x, A)
             krylov = self.ksp.getType() != "preonly"
             fresh = (self.factorizations == 0 or self._force_fresh
@@ -303,6 +310,14 @@ class NonlinearSolver:
         self.u.x.scatter_forward()
         self.timings["solve"] += time.perf_counter() - start
         return its
+
+    def _same_key(self, x) -> bool:
+        """True when ``jacobian_key(x)`` equals the key of the last assembled Jacobian on every
+        rank (the key is then stored)."""
+        key = self.jacobian_key(x)
+        same = self._last_key is not None and np.array_equal(key, self._last_key)
+        self._last_key = key
+        return self.u.function_space.mesh.comm.allreduce(bool(same), op=MPI.LAND)
 
     def _restore(self, guess):
         guess.copy(compat.petsc_vec(self.u))
