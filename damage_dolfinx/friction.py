@@ -31,7 +31,6 @@ from dataclasses import dataclass
 import numpy as np
 import ufl
 from dolfinx import fem
-from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
@@ -144,9 +143,8 @@ class ConstantOperator:
         self.ksp.solve(b, x)
         if self.ksp.getConvergedReason() < 0:
             raise ConvergenceError(
-                f"{self.prefix}ksp failed ({self.ksp.getConvergedReason()}) in example "
-                f"{self.context.example}, step {self.context.step}, t = {self.context.t:.6g}, "
-                f"residual {self.ksp.getResidualNorm():.3e}")
+                f"{self.prefix}ksp failed ({self.ksp.getConvergedReason()}) "
+                f"{self.context.where()}, residual {self.ksp.getResidualNorm():.3e}")
 
 
 class _IterativeFrictionSolver:
@@ -164,17 +162,18 @@ class _IterativeFrictionSolver:
         self.b = self.b0.duplicate()
         V = problem.V
         u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
-        self.K_eps = compat.create_matrix(compat.form(ufl.inner(strain(u), strain(w)) * ufl.dx))
-        compat.assemble_matrix(self.K_eps, compat.form(ufl.inner(strain(u), strain(w)) * ufl.dx), [])
+        k_eps = compat.form(ufl.inner(strain(u), strain(w)) * ufl.dx)
+        self.K_eps = compat.create_matrix(k_eps)
+        compat.assemble_matrix(self.K_eps, k_eps, [])
         self.K_eps.assemble()
+        self._work = self.b0.duplicate()
         self.iterations = 0
         self.solves = 0
         self.timings = {"solve": 0.0}
 
     def _v_norm(self, x):
-        y = x.duplicate()
-        self.K_eps.mult(x, y)
-        return math.sqrt(max(x.dot(y), 0.0))
+        self.K_eps.mult(x, self._work)
+        return math.sqrt(max(x.dot(self._work), 0.0))
 
     def solve(self) -> int:
         start = time.perf_counter()
@@ -182,7 +181,6 @@ class _IterativeFrictionSolver:
             bl.set(0.0)
         compat.assemble_vector(self.b0, self.l)
         self.b0.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self._start()
         x = compat.petsc_vec(self.p.v)
         previous = x.copy()
         for s in range(1, self.max_it + 1):
@@ -198,10 +196,9 @@ class _IterativeFrictionSolver:
             if change <= self.tol * max(size, 1e-300):
                 break
         else:
-            c = self.p.context
-            raise ConvergenceError(f"{self.name} did not converge in {self.max_it} iterations in "
-                                   f"example {c.example}, step {c.step}, t = {c.t:.6g}, relative "
-                                   f"V-change {change / max(size, 1e-300):.3e}")
+            raise ConvergenceError(f"{self.name} did not converge in {self.max_it} iterations "
+                                   f"{self.p.context.where()}, relative V-change "
+                                   f"{change / max(size, 1e-300):.3e}")
         self.iterations += s
         self.solves += 1
         self.timings["solve"] += time.perf_counter() - start
@@ -221,9 +218,6 @@ class Uzawa(_IterativeFrictionSolver):
         super().__init__(problem, problem.a, prefix, tol, **kw)
         self.rho = rho
         self.lam = np.zeros(self.nodes.dofs.size)
-
-    def _start(self):
-        pass
 
     def _multiplier_force(self):
         return self.nodes.g * self.lam
@@ -248,9 +242,6 @@ class PenaltyDuality(_IterativeFrictionSolver):
         super().__init__(problem, operator, prefix, tol, **kw)
         self.eps_reg, self.omega = eps_reg, omega
         self.q = np.zeros(self.nodes.dofs.size)
-
-    def _start(self):
-        pass
 
     def _multiplier_force(self):
         return self.q

@@ -29,6 +29,10 @@ class SolveContext:
     step: int = 0
     t: float = 0.0
 
+    def where(self) -> str:
+        """'in example ID, step N, t = T' for error messages."""
+        return f"in example {self.example}, step {self.step}, t = {self.t:.6g}"
+
 
 def _reason_name(enum, reason: int) -> str:
     for name in dir(enum):
@@ -121,8 +125,7 @@ class LinearSolver:
             r.aypx(-1.0, self.b)
             raise ConvergenceError(
                 f"{self.prefix}ksp did not converge ({_reason_name(PETSc.KSP.ConvergedReason, reason)}) "
-                f"in example {self.context.example}, step {self.context.step}, t = {self.context.t:.6g}, "
-                f"residual {r.norm():.3e}")
+                f"{self.context.where()}, residual {r.norm():.3e}")
         u.x.scatter_forward()
         its = self.ksp.getIterationNumber()
         self.iterations += its
@@ -179,8 +182,7 @@ class SNESSolver:
         if reason <= 0:
             raise ConvergenceError(
                 f"{self.prefix}snes did not converge ({_reason_name(PETSc.SNES.ConvergedReason, reason)}) "
-                f"in example {self.context.example}, step {self.context.step}, t = {self.context.t:.6g}, "
-                f"residual {self.snes.getFunctionNorm():.3e} after {self.snes.getIterationNumber()} iterations")
+                f"{self.context.where()}, residual {self.snes.getFunctionNorm():.3e} after {self.snes.getIterationNumber()} iterations")
         x.copy(x_state)
         x_state.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         x.destroy()

@@ -3,7 +3,6 @@ keeps its bounds, serial = mpirun -n 2, and the stick-slip physics of Example 3.
 import csv
 
 import numpy as np
-import pytest
 
 from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 

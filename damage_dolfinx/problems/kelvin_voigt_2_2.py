@@ -29,7 +29,7 @@ from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..damage import DamageStep, source
 from ..forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
-from ..friction import ContactNodes, FrictionProblem, make_solver
+from ..friction import FrictionProblem, make_solver
 from ..parameters import InputError
 from .base import ProblemData, TimeStepper
 
@@ -107,7 +107,7 @@ class KelvinVoigtTresca(TimeStepper):
         self.extra_history_columns = []
         if point is None:
             return
-        nodes = ContactNodes(self.friction_problem)
+        nodes = self.friction.nodes  # contact nodes, weights and tangents of the solver
         X = self.v.function_space.tabulate_dof_coordinates()[nodes.dofs, :2]
         dist = np.linalg.norm(X - np.asarray(point), axis=1)
         local_best = float(dist.min()) if dist.size else np.inf
@@ -115,15 +115,15 @@ class KelvinVoigtTresca(TimeStepper):
         candidate = self.comm.rank if local_best <= best else self.comm.size
         owner = self.comm.allreduce(candidate, op=MPI.MIN)
         index = int(np.argmin(dist)) if self.comm.rank == owner else None
-        self._probe = (nodes, index, compat.form(residual_form))
+        residual = compat.form(residual_form)
+        self._probe = (nodes, index, residual, compat.create_vector(residual))
         self.extra_history_columns = ["probe_u1", "probe_sigma_tau"]
 
     def scalars(self) -> dict:
         out = super().scalars()
         if not self.extra_history_columns:
             return out
-        nodes, i, residual = self._probe
-        r = compat.create_vector(residual)  # R(w) = a(v, w) - l(w) = -sum_i m_i Phi_i w_tau,i
+        nodes, i, residual, r = self._probe  # R(w) = a(v, w) - l(w) = -sum_i m_i Phi_i w_tau,i
         with r.localForm() as rl:
             rl.set(0.0)
         compat.assemble_vector(r, residual)
