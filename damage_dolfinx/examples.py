@@ -78,7 +78,8 @@ class Example:
 
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
-SECTIONS = ["section_2_1", "section_2_2", "section_2_3", "bridge"]
+SECTIONS = ["section_2_1", "section_2_2", "section_2_3", "bridge", "section_2_4", "section_3_1",
+            "section_3_2", "section_3_3"]
 
 
 def catalogue() -> dict:

@@ -1,0 +1,5 @@
+"""Catalogue entries of thesis Section 3.1 (being written)."""
+
+
+def examples():
+    return []
