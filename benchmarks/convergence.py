@@ -5,7 +5,8 @@
 Runs the example's default study (reference and coarse (n, k) from the catalogue, e.g. 2.3-ex1:
 reference n = 256, k = 5e-4; n in {4, ..., 128} x k in {0.05, ..., 0.001}); writes errors.csv,
 errors.md, convergence.png and summary.json (with wall times and MPI size) under
-results/convergence/<id>. ``--quick``: reference n = 32, k = 0.005 (seconds).
+results/convergence/<id>. ``--quick``: the three coarsest meshes against reference n = 4 x the second one, k = 0.005
+(seconds). For other sizes use ``damage-dolfinx converge ID --ref-n --ref-k --n --k``.
 """
 import argparse
 
@@ -21,8 +22,8 @@ args = parser.parse_args()
 out = args.out or f"results/convergence/{args.id}" + ("-quick" if args.quick else "")
 if args.quick:
     study = examples.get(args.id).convergence
-    ns = [n for n in study["n"] if 32 % n == 0 and n < 32][:3]
-    s = convergence.study(args.id, out, ref_n=32, ref_k=0.005, ns=ns, ks=[0.05, 0.02, 0.01])
+    ns = sorted(study["n"])[:3]
+    s = convergence.study(args.id, out, ref_n=4 * ns[1], ref_k=0.005, ns=ns, ks=[0.05, 0.02, 0.01])
 else:
     s = convergence.study(args.id, out)
 if MPI.COMM_WORLD.rank == 0:

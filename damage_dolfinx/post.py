@@ -58,25 +58,65 @@ class NestedTransfer:
         u_fine.x.array[:] = fine.reshape(-1)
 
 
-class ErrorNorms:
-    """||u_ref - I u_h||_V = ||eps(.)||_L2 and ||zeta_ref - I zeta_h||_L2 on the fine mesh."""
+class NestedTransferDG0:
+    """Exact transfer of a piecewise-constant field (any block size, e.g. the DG0 stress
+    tensors of Section 2.4) from a coarse structured mesh to a nested fine mesh: every fine
+    cell lies in one coarse cell, found from its centroid in the common grid (same layout as
+    :class:`NestedTransfer`: square (i, j), lower triangle when s >= t)."""
 
-    def __init__(self, u_ref, zeta_ref):
+    def __init__(self, V_coarse, V_fine, grid):
+        self.grid, self.comm = grid, V_coarse.mesh.comm
+        self.bs = V_coarse.dofmap.index_map_bs
+        nc = compat.num_owned_cells(V_coarse.mesh)
+        self._coarse_dofs = compat.cell_dofs(V_coarse)[:, 0]
+        self._coarse_index = self._grid_cell(compat.cell_midpoints(V_coarse.mesh)[:nc])
+        fine_cells = compat.cell_midpoints(V_fine.mesh)
+        self._fine_index = self._grid_cell(fine_cells)
+        dl = V_fine.dofmap.list
+        arr = dl.array.reshape(-1, dl.links(0).size) if hasattr(dl, "array") else dl
+        self._fine_dofs = arr[:len(fine_cells), 0]
+
+    def _grid_cell(self, x):
+        g = self.grid
+        s, t = (x[:, 0] - g.x0) / (g.Lx / g.nx), (x[:, 1] - g.y0) / (g.Ly / g.ny)
+        i = np.clip(np.floor(s), 0, g.nx - 1).astype(np.int64)
+        j = np.clip(np.floor(t), 0, g.ny - 1).astype(np.int64)
+        upper = (t - j) > (s - i)
+        return 2 * (j * g.nx + i) + upper
+
+    def __call__(self, u_coarse, u_fine):
+        vals = u_coarse.x.array.reshape(-1, self.bs)[self._coarse_dofs]
+        idx_all = self.comm.allgather(self._coarse_index)
+        val_all = self.comm.allgather(vals)
+        on_grid = np.zeros((2 * self.grid.nx * self.grid.ny, self.bs))
+        on_grid[np.concatenate(idx_all)] = np.concatenate(val_all)
+        fine = u_fine.x.array.reshape(-1, self.bs)
+        fine[self._fine_dofs] = on_grid[self._fine_index]
+
+
+def nested_transfer(V_coarse, V_fine, grid):
+    """The exact nested transfer for P1 (:class:`NestedTransfer`) or DG0 fields."""
+    degree = V_coarse.ufl_element().degree()
+    return NestedTransferDG0(V_coarse, V_fine, grid) if degree == 0 else \
+        NestedTransfer(V_coarse, V_fine, grid)
+
+
+class ComponentNorm:
+    """||f_ref - f||_V (= ||eps(.)||_L2, displacements) or ||f_ref - f||_L2 of one error
+    component, with f given on the fine mesh."""
+
+    def __init__(self, f_ref, norm: str):
         from dolfinx import fem
-        self.u_ref, self.zeta_ref = u_ref, zeta_ref
-        self.e_u = fem.Function(u_ref.function_space)
-        self.e_z = fem.Function(zeta_ref.function_space)
-        self.comm = u_ref.function_space.mesh.comm
-        self._V_form = compat.form(ufl.inner(eps(self.e_u), eps(self.e_u)) * ufl.dx)
-        self._Y_form = compat.form(self.e_z * self.e_z * ufl.dx)
+        if norm not in ("V", "L2"):
+            raise ValueError(f"unknown error norm {norm!r} (V or L2)")
+        self.f_ref, self.e = f_ref, fem.Function(f_ref.function_space)
+        self.comm = f_ref.function_space.mesh.comm
+        integrand = ufl.inner(eps(self.e), eps(self.e)) if norm == "V" else ufl.inner(self.e, self.e)
+        self._form = compat.form(integrand * ufl.dx)
 
-    def __call__(self, u_interp, zeta_interp):
-        """(V error of u, L2 error of zeta) given the coarse fields transferred to the fine mesh."""
-        self.e_u.x.array[:] = self.u_ref.x.array - u_interp.x.array
-        self.e_z.x.array[:] = self.zeta_ref.x.array - zeta_interp.x.array
-        eu = np.sqrt(abs(compat.assemble_scalar(self._V_form, self.comm)))
-        ez = np.sqrt(abs(compat.assemble_scalar(self._Y_form, self.comm)))
-        return eu, ez
+    def __call__(self, f_fine) -> float:
+        self.e.x.array[:] = self.f_ref.x.array - f_fine.x.array
+        return float(np.sqrt(abs(compat.assemble_scalar(self._form, self.comm))))
 
 
 # ---------------------------------------------------------------------------- figures

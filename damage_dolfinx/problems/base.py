@@ -53,6 +53,17 @@ class TimeStepper:
         self.t_const = fem.Constant(self.mesh, 0.0)
         self.output_fields = []
 
+    @property
+    def error_components(self) -> list:
+        """(name, Function, norm) summed in convergence errors; norm "V" = ||eps(.)||_L2 or
+        "L2". Default: ||u||_V + ||zeta||_Y (Cor. 2.1); problems assign their own."""
+        return getattr(self, "_error_components", None) or [("u", self.u, "V"),
+                                                             ("zeta", self.zeta, "L2")]
+
+    @error_components.setter
+    def error_components(self, components):
+        self._error_components = list(components)
+
     # -- time loop interface
     def initialize(self) -> dict:
         self._set_time(0)
