@@ -27,6 +27,9 @@ def _parser():
         sp.add_argument("--quiet", action="store_true", help="no progress lines")
         sp.add_argument("--friction-solver", choices=("newton", "uzawa", "penalty-duality"),
                         help="Tresca solver of Sections 2.2/2.4/3.2 (same as --set friction_solver=...)")
+        sp.add_argument("--friction-law", choices=("tresca", "coulomb"),
+                        help="Section 2.4: Tresca (P1) or simplified Coulomb (P2) "
+                             "(same as --set friction_law=...)")
 
     run = sub.add_parser("run", help="run one example", allow_abbrev=False)
     common(run)
@@ -73,9 +76,11 @@ def _is_option(tok):
         return True
 
 
-def _overrides(pairs, friction_solver=None):
+def _overrides(pairs, friction_solver=None, friction_law=None):
     from .parameters import InputError
     out = {} if friction_solver is None else {"friction_solver": friction_solver}
+    if friction_law is not None:
+        out["friction_law"] = friction_law
     for pair in pairs:
         if "=" not in pair:
             raise InputError(f"--set expects NAME=VALUE, got {pair!r}")
@@ -102,14 +107,14 @@ def main(argv=None):
         if args.command == "run":
             from . import runner
             runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
-                       overrides=_overrides(args.set, args.friction_solver), mesh_file=args.mesh,
+                       overrides=_overrides(args.set, args.friction_solver, args.friction_law), mesh_file=args.mesh,
                        write_every=args.write_every, progress=not args.quiet,
                        figures=not args.no_figures)
             return 0
         if args.command == "converge":
             from . import convergence
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
-                              ns=args.n, ks=args.k, T=args.T, overrides=_overrides(args.set, args.friction_solver),
+                              ns=args.n, ks=args.k, T=args.T, overrides=_overrides(args.set, args.friction_solver, args.friction_law),
                               progress=not args.quiet)
             return 0
     except InputError as exc:

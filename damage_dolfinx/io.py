@@ -108,7 +108,7 @@ class XDMFSeries:
 
 
 def gather_dof_field(u):
-    """On rank 0: (coords (N,2), values (N, bs)) of all owned dofs of a P1 Function, in a
+    """On rank 0: (coords (N,2), values (N, bs)) of all owned dofs of a P1 or DG0 Function, in a
     rank-independent order (sorted by coordinates); None elsewhere."""
     V = u.function_space
     n_owned = V.dofmap.index_map.size_local
@@ -127,7 +127,7 @@ def gather_dof_field(u):
 
 
 def save_final_fields(path, functions: dict):
-    """Write the gathered final P1 fields (name -> Function) to one NPZ (rank 0)."""
+    """Write the gathered final fields (name -> Function) to one NPZ (rank 0)."""
     data = {}
     for name, fn in functions.items():
         gathered = gather_dof_field(fn)

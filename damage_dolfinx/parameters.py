@@ -91,11 +91,18 @@ EXTRA_RULES = {
     "rho_uzawa": (lambda v: v > 0, "(Uzawa step) must be positive"),
     "omega_pd": (lambda v: v > 0, "(penalty-duality parameter) must be positive"),
     "friction_tol": (lambda v: 0 < v < 1, "(relative V-change stopping test) must lie in (0, 1)"),
+    "friction_law": (lambda v: v in ("tresca", "coulomb"), "must be 'tresca' or 'coulomb'"),
+    "coulomb_normal": (lambda v: v in ("free", "bilateral"), "must be 'free' or 'bilateral'"),
+    "viscoplastic_sign": (lambda v: v in (1.0, -1.0), "(sign of G, G19) must be 1 or -1"),
     "memory_kernel": (lambda v: v in ("constant", "exponential"),
                       "must be 'constant' or 'exponential'"),
     "memory_rate": (lambda v: v >= 0, "(decay rate of the exponential kernel) must be >= 0"),
     "memory_mode": (lambda v: v in ("auto", "running", "recursive", "sum"),
                     "must be one of auto, running, recursive, sum"),
+    "stability_check": (lambda v: v in ("warn", "error", "off"),
+                        "(explicit-term time-step check, PROBLEMS.md 1.8) must be warn, error or off"),
+    "damage_active": (lambda v: isinstance(v, bool),
+                      "(False: damage frozen at zeta_0, Section 3.1 Ex. 3) must be true or false"),
 }
 
 

@@ -126,8 +126,9 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         raise
     history.close()
     stepper.update_output()
-    io.save_final_fields(out / "fields_final.npz",
-                         {"u": stepper.u, "zeta": stepper.zeta, "von_mises": stepper.von_mises})
+    final = {"u": stepper.u, "zeta": stepper.zeta, "von_mises": stepper.von_mises}
+    final.update({f.name: f for f in stepper.output_fields if f.name not in final})
+    io.save_final_fields(out / "fields_final.npz", final)
     if figures:
         stepper.update_output()
         summary["outputs"]["figures"] += [draw_figure(ex, fig, stepper, out)
