@@ -1,6 +1,7 @@
-"""Convergence tables of the thesis examples, in parallel (Tables 2.1 and 2.5 so far).
+"""Convergence tables of the thesis examples, in parallel.
 
     mpirun -n 2 .venv/bin/python benchmarks/convergence.py 2.3-ex1 [--quick] [--out DIR]
+    mpirun -n 2 .venv/bin/python benchmarks/convergence.py 2.4-ex1 --set friction_law=coulomb
 
 Runs the example's default study (reference and coarse (n, k) from the catalogue, e.g. 2.3-ex1:
 reference n = 256, k = 5e-4; n in {4, ..., 128} x k in {0.05, ..., 0.001}); writes errors.csv,
@@ -18,14 +19,18 @@ parser = argparse.ArgumentParser()
 parser.add_argument("id")
 parser.add_argument("--quick", action="store_true")
 parser.add_argument("--out", default=None)
+parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                    help="model parameter override, e.g. --set friction_law=coulomb (2.4-ex1 P2)")
 args = parser.parse_args()
+overrides = dict(pair.split("=", 1) for pair in args.set)
 out = args.out or f"results/convergence/{args.id}" + ("-quick" if args.quick else "")
 if args.quick:
     study = examples.get(args.id).convergence
     ns = sorted(study["n"])[:3]
-    s = convergence.study(args.id, out, ref_n=4 * ns[1], ref_k=0.005, ns=ns, ks=[0.05, 0.02, 0.01])
+    s = convergence.study(args.id, out, ref_n=4 * ns[1], ref_k=0.005, ns=ns, ks=[0.05, 0.02, 0.01],
+                          overrides=overrides)
 else:
-    s = convergence.study(args.id, out)
+    s = convergence.study(args.id, out, overrides=overrides)
 if MPI.COMM_WORLD.rank == 0:
     print(f"wall time {s['wall_time_s']:.1f} s on {s['mpi_size']} rank(s); reference run "
           f"{s['reference']['wall_time_s']:.1f} s; rates {s['rates']}")

@@ -39,6 +39,13 @@ def _parser():
     run.add_argument("--mesh", help="gmsh .msh file replacing the built-in geometry")
     run.add_argument("--write-every", type=int, help="XDMF output every N steps (default N/20)")
     run.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    run.add_argument("--checkpoint-every", type=int, metavar="STEPS",
+                     help="write a checkpoint every STEPS steps (default: every "
+                          "--checkpoint-seconds of wall time)")
+    run.add_argument("--checkpoint-seconds", type=float, default=120.0,
+                     help="wall-time interval between checkpoints (0: none; default 120)")
+    run.add_argument("--restart", action="store_true",
+                     help="resume from the checkpoint in --out (any number of MPI ranks)")
 
     conv = sub.add_parser("converge", help="convergence study against a fine reference",
                           allow_abbrev=False)
@@ -107,14 +114,18 @@ def main(argv=None):
         if args.command == "run":
             from . import runner
             runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
-                       overrides=_overrides(args.set, args.friction_solver, args.friction_law), mesh_file=args.mesh,
+                       overrides=_overrides(args.set, args.friction_solver, args.friction_law),
+                       mesh_file=args.mesh,
                        write_every=args.write_every, progress=not args.quiet,
-                       figures=not args.no_figures)
+                       figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
+                       checkpoint_seconds=args.checkpoint_seconds, restart=args.restart)
             return 0
         if args.command == "converge":
             from . import convergence
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
-                              ns=args.n, ks=args.k, T=args.T, overrides=_overrides(args.set, args.friction_solver, args.friction_law),
+                              ns=args.n, ks=args.k, T=args.T,
+                              overrides=_overrides(args.set, args.friction_solver,
+                                                   args.friction_law),
                               progress=not args.quiet)
             return 0
     except InputError as exc:

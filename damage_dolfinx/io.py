@@ -73,13 +73,21 @@ def environment(comm=MPI.COMM_WORLD) -> dict:
 class CSVHistory:
     """One CSV row per time step, flushed immediately (rank 0)."""
 
-    def __init__(self, path, columns, comm=MPI.COMM_WORLD):
+    def __init__(self, path, columns, comm=MPI.COMM_WORLD, keep_until_step=None):
+        """A new file, or with ``keep_until_step`` (restart) the existing rows of steps up to
+        that one followed by the new rows."""
         self.columns, self.comm = list(columns), comm
         self._file = None
         if comm.rank == 0:
+            kept = []
+            if keep_until_step is not None and Path(path).is_file():
+                with open(path, newline="") as f:
+                    kept = [r for r in csv.DictReader(f) if int(r["step"]) <= keep_until_step]
             self._file = open(path, "w", newline="")
             self._writer = csv.DictWriter(self._file, fieldnames=self.columns)
             self._writer.writeheader()
+            for row in kept:
+                self._writer.writerow({c: row.get(c, "") for c in self.columns})
             self._file.flush()
 
     def write(self, row: dict):

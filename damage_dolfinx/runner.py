@@ -21,7 +21,8 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from . import examples, io, post
+from . import checkpoint, examples, io, post
+from .parameters import InputError
 from .geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .solvers import ConvergenceError
 
@@ -45,17 +46,31 @@ class Progress:
               f"min zeta={scalars['zeta_min']:.4f} ({elapsed:.1f} s, ETA {eta:.0f} s)", flush=True)
 
 
+#: default wall-time interval between checkpoints (seconds)
+CHECKPOINT_SECONDS = 120.0
+
+
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
-        write_every=None, progress=True, figures=True, time_limit=None,
-        comm=MPI.COMM_WORLD) -> dict:
+        write_every=None, progress=True, figures=True, time_limit=None, checkpoint_every=None,
+        checkpoint_seconds=CHECKPOINT_SECONDS, restart=False, comm=MPI.COMM_WORLD) -> dict:
     """Run one catalogue example and write its outputs to ``out``; returns the summary.
     With ``time_limit`` (seconds) the run stops after the step that exceeds it, with status
-    "time_limit" (used by benchmarks that skip cells a solver cannot finish)."""
+    "time_limit" (used by benchmarks that skip cells a solver cannot finish).
+
+    Checkpoints (checkpoint.py) are written every ``checkpoint_every`` steps, or else every
+    ``checkpoint_seconds`` of wall time (0: never), and when the run stops early; ``restart``
+    resumes from the checkpoint in ``out`` (same example, mesh, k and parameters; any number
+    of ranks; T may be larger), keeping the history rows up to the checkpoint."""
     wall_start = time.perf_counter()
     ex = examples.get(example_id)
     params, grid, n, h, mesh_file = ex.configure(n, k, T, h, overrides, mesh_file)
+    settings = {"example": ex.id, "n": n, "h": h, "k": grid.k, "overrides": overrides or {},
+                "mesh_file": str(mesh_file) if mesh_file else None}
+    resume = _check_restart(out, settings, grid) if restart else None
     out = io.prepare_output_dir(out, comm)
     stepper = ex.build(comm, n, k, T, h, overrides, mesh_file)
+    if (resume or checkpoint_every) and not stepper.checkpoint_supported:
+        raise InputError(f"example {ex.id} does not support checkpoints")
     N = stepper.num_steps
     write_every = write_every or max(1, N // 20)
 
@@ -67,12 +82,35 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                "outputs": {"xdmf": "fields.xdmf", "history": "history.csv",
                            "final_fields": "fields_final.npz", "figures": []},
                "environment": io.environment(comm)}
-    xdmf = io.XDMFSeries(out / "fields.xdmf", stepper.mesh)
+    xdmf_name = f"fields_from_step{resume['step']}.xdmf" if resume else "fields.xdmf"
+    summary["outputs"]["xdmf"] = xdmf_name
+    xdmf = io.XDMFSeries(out / xdmf_name, stepper.mesh)
     history = io.CSVHistory(out / "history.csv",
                             ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
                              "damage_its", "mech_its", "snes_its", "step_time_s",
-                             *stepper.extra_history_columns], comm)
+                             *stepper.extra_history_columns], comm,
+                            keep_until_step=resume["step"] if resume else None)
     report = Progress(ex.id, N, comm, enabled=progress)
+    previous_wall = resume["wall_time_s"] if resume else 0.0
+    if resume:
+        summary["restarts"] = resume.get("restarts", []) + [
+            {"step": resume["step"], "mpi_size": comm.size, "previous_mpi_size": resume["mpi_size"]}]
+    last_checkpoint = [time.perf_counter()]
+
+    def save_checkpoint():
+        checkpoint.save(out, stepper.checkpoint_state(), {
+            **settings, "step": stepper.n, "t": stepper.t, "mpi_size": comm.size,
+            "wall_time_s": previous_wall + time.perf_counter() - wall_start,
+            "restarts": summary.get("restarts", [])}, comm)
+        last_checkpoint[0] = time.perf_counter()
+
+    def checkpoint_due() -> bool:
+        if not stepper.checkpoint_supported:
+            return False
+        if checkpoint_every:
+            return stepper.n % checkpoint_every == 0
+        elapsed = comm.allreduce(time.perf_counter() - last_checkpoint[0], op=MPI.MAX)
+        return bool(checkpoint_seconds) and elapsed > checkpoint_seconds
 
     def record(stats, step_time):
         scalars = stepper.scalars()
@@ -80,7 +118,8 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                        "step_time_s": f"{step_time:.4g}"})
         summary.update(steps_done=stepper.n, t_final=stepper.t, final=scalars,
                        iterations=stepper.iteration_totals(),
-                       wall_time_s=time.perf_counter() - wall_start, **stepper.summary_extra())
+                       wall_time_s=previous_wall + time.perf_counter() - wall_start,
+                       **stepper.summary_extra())
         return scalars
 
     def write_fields():
@@ -98,11 +137,17 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
 
     try:
         start = time.perf_counter()
-        stats = stepper.initialize()
-        scalars = record(stats, time.perf_counter() - start)
-        write_fields()
-        timed_figures()
-        report(0, 0.0, stats, scalars, force=True)
+        if resume:
+            checkpoint.load(out, stepper.checkpoint_state())
+            stepper.restore(resume["step"])
+            stats, scalars = {}, stepper.scalars()
+            write_fields()
+        else:
+            stats = stepper.initialize()
+            scalars = record(stats, time.perf_counter() - start)
+            write_fields()
+            timed_figures()
+        report(stepper.n, stepper.t, stats, scalars, force=True)
         while stepper.n < N:
             start = time.perf_counter()
             stats = stepper.advance()
@@ -112,6 +157,8 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                 stop = stop or "time_limit"
             if stop or stepper.n % write_every == 0 or stepper.n == N:
                 write_fields()
+            if (stop and stepper.n < N) or checkpoint_due():
+                save_checkpoint()
             timed_figures()
             report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
             if stop:
@@ -134,12 +181,24 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         summary["outputs"]["figures"] += [draw_figure(ex, fig, stepper, out)
                                           for fig in ex.figures if not fig.times]
     summary["timings_s"] = dict(getattr(stepper, "timings", {}))
-    summary["wall_time_s"] = time.perf_counter() - wall_start
+    summary["wall_time_s"] = previous_wall + time.perf_counter() - wall_start
     io.write_json(out / "summary.json", summary, comm)
     if comm.rank == 0 and progress:
         print(f"[{ex.id}] {summary['status']} at t = {stepper.t:.5g} after {stepper.n} steps in "
               f"{summary['wall_time_s']:.1f} s on {comm.size} rank(s); output in {out}", flush=True)
     return summary
+
+
+def _check_restart(out, settings, grid) -> dict:
+    """The checkpoint metadata in ``out`` after checking it belongs to this run."""
+    meta = checkpoint.read_meta(out)
+    for key, value in settings.items():
+        if meta.get(key) != value:
+            raise InputError(f"cannot restart: the checkpoint in {str(out)!r} has {key} = "
+                             f"{meta.get(key)!r}, this run {value!r}")
+    if meta["step"] > grid.num_steps:
+        raise InputError(f"cannot restart: the checkpoint is at t = {meta['t']}, beyond T = {grid.T}")
+    return meta
 
 
 def auto_amplification(stepper, diameter) -> float:

@@ -64,6 +64,23 @@ class TimeStepper:
     def error_components(self, components):
         self._error_components = list(components)
 
+    # -- checkpoint/restart (checkpoint.py)
+    #: steppers whose state is more than Functions (e.g. the bridge's failure record) set False
+    checkpoint_supported = True
+
+    def checkpoint_state(self) -> dict:
+        """name -> Function: everything the next step reads (u, zeta, and v, sigma, ... where
+        the scheme has them). Steppers with more state extend this."""
+        state = {"u": self.u, "zeta": self.zeta}
+        for name in ("v", "w", "sigma"):
+            if isinstance(getattr(self, name, None), fem.Function):
+                state[name] = getattr(self, name)
+        return state
+
+    def restore(self, n: int):
+        """Continue from time level n after checkpoint.load() has set checkpoint_state()."""
+        self._set_time(n)
+
     # -- time loop interface
     def initialize(self) -> dict:
         self._set_time(0)

@@ -75,6 +75,8 @@ def check_bridge_parameters(extra: dict):
 class BridgeDamage(ElasticDamage):
     """Problem VP^{hk} of Section 2.1 on the arch ring, with the collapse criterion."""
 
+    checkpoint_supported = False  # the failure record and hinge list are not saved
+
     extra_history_columns = ["P_kN", "u_load_y", "weakest_section", "weakest_section_zeta_max",
                              "n_hinges"]
 

@@ -26,6 +26,7 @@ from ..constitutive import eps, von_mises
 from ..damage import DamageStep, source
 from ..forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
 from ..memory import MemoryKernel, MemoryTerm
+from ..parameters import InputError
 from ..solvers import NonlinearSolver
 from .base import ProblemData, TimeStepper
 
@@ -85,6 +86,12 @@ class ViscoelasticMemoryContact(TimeStepper):
         self._stress_sq = compat.form(ufl.inner(sigma, sigma) * ufl.dx)
         self.output_fields = [self.u, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "memory": 0.0, "mech": 0.0}
+
+    def checkpoint_state(self) -> dict:
+        """u, zeta and the memory M_n (running/recursive modes keep no other history)."""
+        if self.memory.mode == "sum":
+            raise InputError("memory mode 'sum' stores the whole history: no checkpoints")
+        return {**super().checkpoint_state(), "memory": self.memory.M}
 
     def _initial_state(self) -> dict:
         self.interpolate_zeta0(self.zeta)
