@@ -15,17 +15,18 @@ export MPLBACKEND := Agg
 
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix \
     python3-ffcx python3-gmsh gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
-    python3-venv python3-setuptools gcc
+    python3-venv python3-setuptools gcc chromium
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-.PHONY: setup system-deps demo test bench convergence clean
+.PHONY: setup system-deps demo test bench convergence convergence-quick figures figures-quick \
+    report clean
 
 setup: $(VENV)/.installed
 
 # Install the Debian stack only if /usr/bin/python3 cannot already import it.
 system-deps:
 	@if /usr/bin/python3 -c "import dolfinx, petsc4py, mpi4py, ufl, basix, ffcx, gmsh, matplotlib, pytest, scipy" \
-	    2>/dev/null && command -v mpirun >/dev/null; then \
+	    2>/dev/null && command -v mpirun >/dev/null && command -v chromium >/dev/null; then \
 	  echo "setup: Debian FEniCSx stack present"; \
 	else \
 	  echo "setup: installing the Debian FEniCSx stack (apt-get)"; \
@@ -56,9 +57,23 @@ bench: setup
 	$(MPIRUN) $(PY) benchmarks/bridge_collapse.py
 	$(PY) benchmarks/bridge_sensitivity.py
 
+# All convergence studies at thesis resolution, references on $(NP) ranks (make convergence NP=4).
 convergence: setup
-	$(MPIRUN) $(PY) benchmarks/convergence.py 2.1-ex1
-	$(MPIRUN) $(PY) benchmarks/convergence.py 2.3-ex1
+	$(PY) benchmarks/convergence_all.py --np $(NP) --out $(OUT)/convergence
+
+convergence-quick: setup
+	$(PY) benchmarks/convergence_all.py --quick --np $(NP) --out $(OUT)/convergence-quick
+
+# Every thesis figure with a computed result (PNG named after the figure number).
+figures: setup
+	$(PY) benchmarks/figures.py --np $(NP) --out $(OUT)/figures
+
+figures-quick: setup
+	$(PY) benchmarks/figures.py --quick --np $(NP) --out $(OUT)/figures-quick
+
+# results/REPORT.md and results/REPORT.html from the figures, tables and benchmark outputs.
+report: setup
+	$(PY) benchmarks/report.py --results $(OUT)
 
 clean:
 	rm -rf $(VENV) results .pytest_cache build *.egg-info

@@ -1,0 +1,214 @@
+"""One-command reproduction of the thesis figures (``make figures``) and convergence tables
+(``make convergence``): the list of runs, how to launch them, and the index of what they wrote.
+
+Every figure run is one ``damage-dolfinx run`` (under ``mpirun -n NP``) of a catalogue example;
+its PNG files, already named after the thesis figures, are copied into the figures folder with
+the run's variant appended where an example has several (e.g. 2.4-ex1 Tresca / Coulomb).
+``index.json`` there records, per figure, the example, variant, command, status and wall time;
+the report (report.py) is built from it. A failed run is recorded and the others go on.
+
+Quick mode: coarse meshes (n / 4, 2h) at the thesis time steps, minutes in total. Full mode: the
+catalogue defaults, i.e. the thesis resolutions (or the documented G-defaults).
+"""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+#: variants of an example that the thesis draws separately: suffix -> parameter overrides
+VARIANTS = {
+    "2.4-ex1": {"tresca": {"friction_law": "tresca"}, "coulomb": {"friction_law": "coulomb"}},
+    "3.1-ex3": {"undamaged": {"damage_active": "0"}, "damaged": {"damage_active": "1"}},
+    "3.3-ex2": {"a": {"initial_damage": "a"}, "b": {"initial_damage": "b"}},
+}
+
+#: thesis figure of each convergence study (example id, variant) -> file stem
+CONVERGENCE_FIGURES = {
+    ("2.1-ex1", ""): "figure_2_2", ("2.2-ex2", ""): "figure_2_11", ("2.3-ex1", ""): "figure_2_15",
+    ("2.4-ex1", "tresca"): "figure_2_23_left", ("2.4-ex1", "coulomb"): "figure_2_23_right",
+    ("3.1-ex1", ""): "figure_3_2", ("3.2-ex1", ""): "table_3_2_plot", ("3.3-ex1", ""): "figure_3_16",
+}
+
+#: examples whose figures come from the catalogue run alone; the bridge has its own benchmark
+SKIP_RUN = {"2.2-ex2"}  # same physics as 2.2-ex1, only a convergence table
+
+
+@dataclass
+class Job:
+    example: str
+    variant: str = ""
+    options: list = field(default_factory=list)  # CLI options (--n, --k, --h, --set ...)
+
+    @property
+    def name(self) -> str:
+        return self.example + (f"-{self.variant}" if self.variant else "")
+
+
+def _quick_options(ex) -> list:
+    """Coarse mesh at the thesis time step: n / 4 (at least 4) or 2 h."""
+    if ex.n is not None:
+        return ["--n", str(max(4, ex.n // 4))]
+    if ex.h is not None:
+        return ["--h", f"{2 * ex.h:g}"]
+    return []
+
+
+def figure_jobs(mode: str) -> list:
+    """One Job per (example, variant) of the catalogue."""
+    from . import examples
+    jobs = []
+    for ex in examples.catalogue().values():
+        if ex.id in SKIP_RUN or not ex.figures:
+            continue
+        base = _quick_options(ex) if mode == "quick" else []
+        for variant, sets in (VARIANTS.get(ex.id) or {"": {}}).items():
+            options = list(base)
+            for key, value in sets.items():
+                options += ["--set", f"{key}={value}"]
+            jobs.append(Job(ex.id, variant, options))
+    return jobs
+
+
+def convergence_jobs(mode: str) -> list:
+    """One Job per convergence study (variants of 2.4-ex1: both friction laws)."""
+    from . import examples
+    jobs = []
+    for ex in examples.catalogue().values():
+        if not ex.convergence:
+            continue
+        if mode == "quick":
+            ns = sorted(ex.convergence["n"])[:3]
+            ks = sorted(ex.convergence["k"], reverse=True)[:3]
+            ref_k = min(ks) / 2
+            base = ["--ref-n", str(4 * ns[1]), "--ref-k", f"{ref_k:g}",
+                    "--n", *map(str, ns), "--k", *(f"{k:g}" for k in ks)]
+        else:
+            base = []
+        for variant, sets in (VARIANTS.get(ex.id) or {"": {}}).items():
+            options = list(base)
+            for key, value in sets.items():
+                options += ["--set", f"{key}={value}"]
+            jobs.append(Job(ex.id, variant, options))
+    return jobs
+
+
+def _launch(command: list, np_: int, log: Path) -> tuple:
+    """Run the CLI command (under mpirun if np_ > 1); returns (returncode, wall seconds, argv)."""
+    argv = [sys.executable, "-m", "damage_dolfinx.cli", *command]
+    if np_ > 1:
+        argv = ["mpirun", "-n", str(np_), *argv]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1", MPLBACKEND="Agg")
+    start = time.perf_counter()
+    with open(log, "w") as f:
+        code = subprocess.call(argv, stdout=f, stderr=subprocess.STDOUT, env=env)
+    return code, time.perf_counter() - start, argv
+
+
+def _display(command: list, np_: int) -> str:
+    """The command as a user types it."""
+    return (f"mpirun -n {np_} " if np_ > 1 else "") + "damage-dolfinx " + " ".join(command)
+
+
+def run_figures(mode: str, out: Path, np_: int = 2, only=None) -> dict:
+    """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``."""
+    out.mkdir(parents=True, exist_ok=True)
+    runs = out / "runs"
+    index = {"mode": mode, "mpi_size": np_, "runs": [], "figures": []}
+    start = time.perf_counter()
+    for job in figure_jobs(mode):
+        if only and job.example not in only:
+            continue
+        run_dir = runs / job.name
+        if run_dir.exists():
+            shutil.rmtree(run_dir)
+        run_dir.mkdir(parents=True)
+        command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir)]
+        code, wall, _ = _launch(command, np_, run_dir / "log.txt")
+        entry = {"example": job.example, "variant": job.variant, "command": _display(command, np_),
+                 "returncode": code, "wall_time_s": round(wall, 2), "folder": str(run_dir)}
+        summary = run_dir / "summary.json"
+        if summary.is_file():
+            s = json.loads(summary.read_text())
+            entry.update(status=s.get("status"), title=s.get("title"),
+                         figures=[f["file"] for f in s["outputs"]["figures"]])
+            for fig in s["outputs"]["figures"]:
+                target = Path(fig["file"]).stem + (f"_{job.variant}" if job.variant else "") + ".png"
+                shutil.copy(run_dir / fig["file"], out / target)
+                index["figures"].append({"file": target, "example": job.example,
+                                         "variant": job.variant, "title": s.get("title"),
+                                         "command": entry["command"], **{
+                                             k: fig[k] for k in ("t", "amplification") if k in fig}})
+        index["runs"].append(entry)
+        print(f"[figures] {job.name}: exit {code}, {wall:.1f} s", flush=True)
+        (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    if not only or "2.1-ex3" in only:
+        _bridge_force_displacement(mode, out, np_, index)
+    index["wall_time_s"] = round(time.perf_counter() - start, 1)
+    (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    return index
+
+
+def _bridge_force_displacement(mode, out, np_, index):
+    """Figure 2.7 (force-displacement curve of the arch) from benchmarks/bridge_collapse.py."""
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bridge_collapse.py"
+    if not script.is_file():
+        return
+    folder = out / "runs" / "bridge_collapse"
+    folder.mkdir(parents=True, exist_ok=True)
+    options = ["--h", "0.1"] if mode == "quick" else []
+    argv = [sys.executable, str(script), *options, "--out", str(folder)]
+    if np_ > 1:
+        argv = ["mpirun", "-n", str(np_), *argv]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1", MPLBACKEND="Agg")
+    start = time.perf_counter()
+    with open(folder / "log.txt", "w") as f:
+        code = subprocess.call(argv, stdout=f, stderr=subprocess.STDOUT, env=env)
+    command = (f"mpirun -n {np_} " if np_ > 1 else "") + \
+        f"python benchmarks/bridge_collapse.py {' '.join(options)} --out {folder}"
+    index["runs"].append({"example": "2.1-ex3", "variant": "force-displacement",
+                          "command": command, "returncode": code,
+                          "wall_time_s": round(time.perf_counter() - start, 2), "folder": str(folder)})
+    if code == 0 and (folder / "force_displacement.png").is_file():
+        shutil.copy(folder / "force_displacement.png", out / "figure_2_7.png")
+        index["figures"].append({"file": "figure_2_7.png", "example": "2.1-ex3", "variant": "",
+                                 "title": "arch bridge: force-displacement curve",
+                                 "command": command})
+
+
+def run_convergence(mode: str, out: Path, np_: int = 2, only=None) -> dict:
+    """Run every convergence study into ``out/<id>[-variant]`` and write ``out/index.json``."""
+    out.mkdir(parents=True, exist_ok=True)
+    index = {"mode": mode, "mpi_size": np_, "studies": []}
+    start = time.perf_counter()
+    for job in convergence_jobs(mode):
+        if only and job.example not in only:
+            continue
+        folder = out / job.name
+        folder.mkdir(parents=True, exist_ok=True)
+        command = ["converge", job.example, *job.options, "--quiet", "--out", str(folder)]
+        code, wall, _ = _launch(command, np_, folder / "log.txt")
+        entry = {"example": job.example, "variant": job.variant, "command": _display(command, np_),
+                 "returncode": code, "wall_time_s": round(wall, 2), "folder": str(folder)}
+        summary = folder / "summary.json"
+        if code == 0 and summary.is_file():
+            s = json.loads(summary.read_text())
+            entry.update(rates=s["rates"], reference_wall_time_s=s["reference"]["wall_time_s"],
+                         ref_n=s["ref_n"], ref_k=s["ref_k"])
+            stem = CONVERGENCE_FIGURES.get((job.example, job.variant))
+            if stem:
+                shutil.copy(folder / "convergence.png", out / f"{stem}.png")
+                entry["figure"] = f"{stem}.png"
+        index["studies"].append(entry)
+        print(f"[convergence] {job.name}: exit {code}, {wall:.1f} s", flush=True)
+        (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    index["wall_time_s"] = round(time.perf_counter() - start, 1)
+    (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    return index
