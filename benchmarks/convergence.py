@@ -6,8 +6,8 @@
 Runs the example's default study (reference and coarse (n, k) from the catalogue, e.g. 2.3-ex1:
 reference n = 256, k = 5e-4; n in {4, ..., 128} x k in {0.05, ..., 0.001}); writes errors.csv,
 errors.md, convergence.png and summary.json (with wall times and MPI size) under
-results/convergence/<id>. ``--quick``: the three coarsest meshes against reference n = 4 x the second one, k = 0.005
-(seconds). For other sizes use ``damage-dolfinx converge ID --ref-n --ref-k --n --k``.
+results/convergence/<id>. ``--quick``: the three coarsest meshes and largest time steps of the example against reference
+n = 4 x the second mesh, k = half the smallest step (seconds to minutes). For other sizes use ``damage-dolfinx converge ID --ref-n --ref-k --n --k``.
 """
 import argparse
 
@@ -26,8 +26,8 @@ overrides = dict(pair.split("=", 1) for pair in args.set)
 out = args.out or f"results/convergence/{args.id}" + ("-quick" if args.quick else "")
 if args.quick:
     study = examples.get(args.id).convergence
-    ns = sorted(study["n"])[:3]
-    s = convergence.study(args.id, out, ref_n=4 * ns[1], ref_k=0.005, ns=ns, ks=[0.05, 0.02, 0.01],
+    ns, ks = sorted(study["n"])[:3], sorted(study["k"], reverse=True)[:3]
+    s = convergence.study(args.id, out, ref_n=4 * ns[1], ref_k=ks[-1] / 2, ns=ns, ks=ks,
                           overrides=overrides)
 else:
     s = convergence.study(args.id, out, overrides=overrides)

@@ -103,6 +103,12 @@ EXTRA_RULES = {
                         "(explicit-term time-step check, PROBLEMS.md 1.8) must be warn, error or off"),
     "damage_active": (lambda v: isinstance(v, bool),
                       "(False: damage frozen at zeta_0, Section 3.1 Ex. 3) must be true or false"),
+    "elastic_term": (lambda v: v in ("explicit", "implicit"),
+                     "(Section 3.3: explicit = thesis scheme, implicit = G33 deviation) must be "
+                     "'explicit' or 'implicit'"),
+    "initial_damage": (lambda v: v in ("a", "b"),
+                       "(Section 3.3 Ex. 2: a = centre [2.5,3.5]^2, b = bottom [2.5,3.5]x[0,1]) "
+                       "must be 'a' or 'b'"),
 }
 
 

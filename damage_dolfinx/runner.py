@@ -167,7 +167,8 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         else:
             summary["status"] = "completed"
     except ConvergenceError as exc:
-        summary.update(status="failed", error=str(exc))
+        summary.update(status="failed", error=str(exc),
+                       wall_time_s=previous_wall + time.perf_counter() - wall_start)
         io.write_json(out / "summary.json", summary, comm)
         history.close()
         raise
