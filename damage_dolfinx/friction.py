@@ -47,6 +47,10 @@ JACOBIAN_SHIFT = 1e-3
 REFACTOR_ITS = 10
 
 SOLVERS = ("newton", "uzawa", "penalty-duality")
+#: the first attempt of each step: full Newton steps (no energy evaluations), at most this many
+FAST_MAX_IT = 6
+#: after a failed first attempt, go straight to the energy line search for this many steps
+FAST_PAUSE_STEPS = 10
 
 
 @dataclass
@@ -314,8 +318,29 @@ class RegularisedNewton:
         self.iterations = 0
         self.solves = 0
         self.continuations = self.shifted_continuations = self.full_step_solves = 0
+        self.fast_failures, self._fast_pause = 0, 0
         self.prefix = prefix
         self.timings = {"solve": 0.0}
+
+    def _fast_attempt(self) -> bool:
+        """Full Newton steps (basic line search: one residual per iteration, no energy) from
+        the previous velocity, at most FAST_MAX_IT iterations; False if skipped or failed (v is
+        then unchanged). Skipped for FAST_PAUSE_STEPS steps after a failure (stick-slip
+        phases, where it rarely succeeds)."""
+        if self._fast_pause > 0:
+            self._fast_pause -= 1
+            return False
+
+        def solve():
+            self.snes.snes.setTolerances(max_it=FAST_MAX_IT)
+            return self.newton.solve()
+        try:
+            self._with_line_search("basic", solve)
+            return True
+        except ConvergenceError:
+            self.fast_failures += 1
+            self._fast_pause = FAST_PAUSE_STEPS
+            return False
 
     def _with_line_search(self, kind, fn):
         opts, key = PETSc.Options(), self.prefix + "snes_linesearch_type"
@@ -360,8 +385,9 @@ class RegularisedNewton:
         start = time.perf_counter()
         before = self.snes.iterations
         self.eps.value = self.target
-        try:  # Newton from the previous step's velocity, line search on the energy
-            self.newton.solve()
+        try:
+            if not self._fast_attempt():  # full steps; Newton with the energy line search:
+                self.newton.solve()
         except ConvergenceError:
             self.continuations += 1  # v is unchanged: restart with eps continuation
             try:
