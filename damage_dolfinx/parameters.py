@@ -103,6 +103,8 @@ EXTRA_RULES = {
                         "(explicit-term time-step check, PROBLEMS.md 1.8) must be warn, error or off"),
     "damage_active": (lambda v: isinstance(v, bool),
                       "(False: damage frozen at zeta_0, Section 3.1 Ex. 3) must be true or false"),
+    "error_norm": (lambda v: v in ("velocity", "displacement"),
+                   "(convergence error of Section 3.1, G27) must be velocity or displacement"),
     "elastic_term": (lambda v: v in ("explicit", "implicit"),
                      "(Section 3.3: explicit = thesis scheme, implicit = G33 deviation) must be "
                      "'explicit' or 'implicit'"),

@@ -167,8 +167,10 @@ def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None)
         ax.set_ylabel("x2 [m]")
         fig.colorbar(im, ax=ax, shrink=0.85)
     suffix = f"  (displacements x{amplification:g})" if amplification not in (0, 1) else ""
-    fig.suptitle(title + suffix)
-    fig.tight_layout()
+    import textwrap
+    lines = textwrap.wrap(title + suffix, width=50 * len(gathered))  # no clipping on 1 panel
+    fig.suptitle("\n".join(lines), fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.045 * len(lines)))
     fig.savefig(path, dpi=130)
     plt.close(fig)
 

@@ -225,6 +225,7 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
         return {"file": filename}
     fields = {"von_mises": (stepper.von_mises, "von Mises stress [Pa]"),
               "zeta": (stepper.zeta, "damage zeta [-]")}
+    fields.update(getattr(stepper, "figure_fields", {}))  # problem-specific (name: (Function, label))
     amp = fig.amplification or auto_amplification(stepper, ex.diameter)
     post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / filename,
                      amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True)

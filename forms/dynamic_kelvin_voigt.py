@@ -1,0 +1,43 @@
+"""Section 3.1: dynamic Kelvin-Voigt body, frictionless normal compliance, velocity step (3.48):
+
+    (rho (v_n - v_{n-1})/k, w) + (A eps(v_n), eps(w)) + (zeta_{n-1} Phi_L(B eps(u_{n-1})), eps(w))
+        + int_{Gamma_C} p_nu(u_{n-1}.nu - gap) w.nu ds = L_n(w)          for all w in V^h,
+
+A = B / m_visc, p_nu(r) = c_nu r_+. Inertia and viscosity implicit (a constant bilinear form for
+a fixed k), the damaged truncated elastic force (2.106) and the contact force explicit, i.e. a
+linear system with a fixed matrix (the thesis' (3.64) is this equation times k, G28).
+"""
+import ufl
+
+from damage_dolfinx.constitutive import eps
+from damage_dolfinx.contact import normal_compliance_pressure
+
+from .elastic_damage import load
+from .kelvin_voigt import damaged_elastic_stress, viscous_stress
+
+#: quadrature degree of the truncated (Phi_L) and positive-part (contact) terms (G38)
+NONLINEAR_DEGREE = 2
+
+
+def total_stress(v, u, zeta, E, nu, m_visc, L_trunc):
+    """sigma_n = A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (Sections 1.6, 1.9)."""
+    return viscous_stress(v, E, nu, m_visc) + damaged_elastic_stress(u, zeta, E, nu, L_trunc)
+
+
+def velocity_step_forms(v, w, v_old, u_old, zeta_old, rho, k, E, nu, m_visc, L_trunc, c_nu, gap,
+                        n, f_B, f_N, dsN, dsC):
+    """(a, l) of (3.48): v, w trial/test functions of V^h; v_old, u_old, zeta_old at step n-1;
+    rho, k, c_nu, gap numbers or fem.Constants; n the outward unit normal; dsC = None for no
+    contact part."""
+    dx = ufl.dx
+    dxq = ufl.dx(metadata={"quadrature_degree": NONLINEAR_DEGREE})
+    a = (rho / k * ufl.inner(v, w) * dx                                       # (3.48) (rho delta v_n, w)_H
+         + ufl.inner(viscous_stress(v, E, nu, m_visc), eps(w)) * dx)          # (3.48) (A eps(v_n), eps(w))_Q
+    l = (rho / k * ufl.inner(v_old, w) * dx                                   # (3.48) (rho v_{n-1}/k, w)_H
+         - ufl.inner(damaged_elastic_stress(u_old, zeta_old, E, nu, L_trunc),
+                     eps(w)) * dxq)                                           # (3.48) (E(eps(u_{n-1}), zeta_{n-1}), eps(w))_Q
+    if dsC is not None:
+        dsq = dsC(metadata={"quadrature_degree": NONLINEAR_DEGREE})
+        l -= normal_compliance_pressure(u_old, n, c_nu, gap) * ufl.dot(w, n) * dsq  # (3.48) j(u_{n-1}, w)
+    L = load(w, f_B, f_N, dsN)                                                # (3.48) <f_n, w>
+    return a, (l if L is None else l + L)
