@@ -51,7 +51,10 @@ class Job:
 
 
 #: quick mode: larger time steps where the scheme allows them (quasistatic, below 2/m_visc)
-QUICK_EXTRA = {"2.2-ex3": ["--k", "0.01"], "2.4-ex1": ["--k", "0.01"], "2.4-ex2": ["--k", "0.01"]}
+#: and, for the inertia-limited 3.3 examples, a stable k of the coarse mesh (0.7 k_max) and a
+#: shorter wrench run
+QUICK_EXTRA = {"2.2-ex3": ["--k", "0.01"], "2.4-ex1": ["--k", "0.01"], "2.4-ex2": ["--k", "0.01"],
+               "3.3-ex2": ["--k", "2.5e-4"], "3.3-ex3": ["--k", "2e-5", "--T", "0.5"]}
 
 
 def _quick_options(ex) -> list:

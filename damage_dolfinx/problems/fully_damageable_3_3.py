@@ -1,0 +1,344 @@
+"""Section 3.3: dynamic, fully damageable frictionless contact (damage scales the viscosity, the
+elasticity and the contact pressure), damage by the obstacle inclusion (variant A), scheme
+(3.158)-(3.160):
+
+    (1) zeta_n in K^h:  (zeta_n - zeta_{n-1}, xi - zeta_n) + k kappa (grad zeta_n, grad(xi - zeta_n))
+                        >= k (phi_A(eps(u_{n-1}), eta_*(zeta_{n-1})), xi - zeta_n)
+                                                               (3.158), SNES vinewtonrsls
+    (2) v_n in V^h:     (rho (v_n - v_{n-1})/k, w) + (zeta_n A eps(v_n), eps(w))
+                        = L_n(w) - (zeta_{n-1} Phi_L(B eps(u_{n-1})), eps(w))
+                          - int_{Gamma_C} zeta_{n-1} c_nu (u_{n-1}.nu - gap)_+ w.nu ds
+                                                               (3.159), linear
+    (3) u_n = u_{n-1} + k v_n                                  (3.160)
+
+Order matters: the viscosity of (2) uses the NEW damage zeta_n of (1), so the matrix of (2)
+changes every step; it is re-assembled into the same PETSc Mat and solved by CG + Jacobi (prefix
+``mech_``; the mass rho/k M dominates when m_visc is large, Examples 2-3). V = {v = 0 on
+Gamma_D} (Gamma_D may be empty: the mass keeps (2) definite). u_0 = v_0 = 0.
+
+Parameters in ``extra``: rho, m_visc, c_nu, gap, ``damage_active`` (False: zeta frozen at
+zeta_0), ``stability_check`` (warn | error | off; k against the limit of the explicit elastic
+and contact forces, stability.py, PROBLEMS.md 1.8), ``elastic_term`` = ``explicit`` (the thesis)
+or ``implicit`` (G33 deviation, NOT the thesis scheme: elastic and contact forces at
+u_{n-1} + k v_n, a semismooth Newton solve per step, prefix ``mech_``), ``initial_damage``
+(a key of ``builders["zeta0"]``, Example 2's cases a/b).
+
+Output: von Mises of the total stress zeta_n A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (DG0);
+history columns v_L2, the maximal interpenetration (u.nu - gap)_+ over the Gamma_C vertices and
+its location, and zeta at ``builders["probe"]``; damage profiles along x_2 =
+``builders["profile_x2"]`` every ``builders["profile_every"]`` s (plus the latest state) in
+summary.json. Convergence errors in the norm of Cor. 3.3: ||u||_L2 + ||zeta||_L2.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+
+from .. import compat
+from ..boundary import clamped
+from ..constitutive import eps, von_mises
+from ..damage import DamageStep, source
+from ..forms.fully_damageable import (implicit_velocity_residual, total_stress,
+                                      velocity_step_forms)
+from ..parameters import InputError
+from ..solvers import LinearSolver, NonlinearSolver
+from .base import ProblemData, TimeStepper
+
+#: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, warm start v_{n-1};
+#: override with -mech_ksp_type / -mech_pc_type (e.g. hypre)
+MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
+                 "ksp_max_it": 5000, "ksp_initial_guess_nonzero": True}
+
+
+class FullyDamageableContact(TimeStepper):
+    """Problem VP^{hk} of Section 3.3."""
+
+    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+        super().__init__(data)
+        p, msh, x = self.params, self.mesh, data.params.extra
+        V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+        self.u, self.u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
+        self.v, self.v_old = fem.Function(V, name="v"), fem.Function(V, name="v_old")
+        self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
+        self.k = data.time.k
+        self.rho, self.m_visc = float(x["rho"]), float(x["m_visc"])
+        self.c_nu, self.gap = float(x["c_nu"]), float(x.get("gap", 0.0))
+        self.damage_active = bool(x.get("damage_active", True))
+        self.elastic_term = x.get("elastic_term", "explicit")
+        self.error_components = [("u", self.u, "L2"), ("zeta", self.zeta, "L2")]  # Cor. 3.3
+
+        # (3.158): damage obstacle step, source phi_A(eps(u_{n-1}), eta_*(zeta_{n-1}))
+        self.damage = None
+        if self.damage_active:
+            phi_old = source(eps(self.u_old), self.zeta_old, p)
+            self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.k),
+                                     fem.Constant(msh, float(p.kappa)), self.context,
+                                     obstacle=True, zeta_star=p.zeta_star, prefix=damage_prefix)
+
+        # (3.159): velocity with the new damage in the viscosity
+        tags = data.geometry.facet_tags
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+        self.n_facet = ufl.FacetNormal(msh)
+        f_B, f_N = self.loads()
+        const = lambda value: fem.Constant(msh, float(value))  # noqa: E731
+        args = (self.v_old, self.u_old, self.zeta, self.zeta_old, const(self.rho), const(self.k),
+                p.E, p.nu, self.m_visc, p.L_trunc, p.zeta_star, const(self.c_nu), const(self.gap),
+                self.n_facet, f_B, f_N, ds(GAMMA_N), ds(GAMMA_C))
+        self.bcs = [clamped(V, tags, GAMMA_D)]
+        w = ufl.TestFunction(V)
+        if self.elastic_term == "explicit":
+            a, l = velocity_step_forms(ufl.TrialFunction(V), w, *args)
+            self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context,
+                                     constant_matrix=False, defaults=MECH_DEFAULTS)
+        elif self.elastic_term == "implicit":  # G33 deviation
+            F = implicit_velocity_residual(self.v, w, *args)
+            self.mech = NonlinearSolver(F, self.v, self.bcs, mech_prefix, self.context)
+        else:
+            raise InputError("elastic_term must be 'explicit' or 'implicit', "
+                             f"got {self.elastic_term!r}")
+        self.stability = self._stability_check(V, x, ds(GAMMA_C))
+
+        # output: von Mises of the total stress (PROBLEMS.md 1.9), DG0
+        Q = compat.scalar_dg0(msh)
+        self.von_mises = fem.Function(Q, name="von_mises")
+        sigma = total_stress(self.v, self.u, self.zeta, p.E, p.nu, self.m_visc, p.L_trunc,
+                             p.zeta_star)
+        self._vm_expr = compat.expression(von_mises(sigma), Q)
+        self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
+        self._v_sq = compat.form(ufl.inner(self.v, self.v) * ufl.dx)
+        self.contact = ContactMonitor(V, tags, GAMMA_C, self.gap)
+        self.probe = ZetaProbe(Z, data.builders.get("probe"))
+        choice = x.get("initial_damage")
+        line = data.builders.get("profile_x2")
+        if isinstance(line, dict):
+            line = line.get(choice)
+        self.profiles = DamageProfiles(Z, line, data.builders.get("profile_every", 0.5), self.k)
+        self.extra_history_columns = (["v_L2"] + self.contact.columns + self.probe.columns)
+        self.timings = {"damage": 0.0, "velocity": 0.0,
+                        "stability": self.stability.get("time_s", 0.0)}
+
+    # -- the scheme
+    def _initial_state(self) -> dict:
+        self._interpolate_zeta0()  # u_0 = v_0 = 0
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        self.profiles.sample(self.zeta, self.t)
+        return {}
+
+    def _advance(self) -> dict:
+        self.u_old.x.array[:] = self.u.x.array
+        self.v_old.x.array[:] = self.v.x.array
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        damage_its = self._timed("damage", self.damage.solve) if self.damage else 0  # (3.158)
+        if self.elastic_term == "explicit":
+            mech_its = self._timed("velocity", self.mech.solve, self.v)            # (3.159)
+            stats = {"damage_its": damage_its, "mech_its": mech_its}
+        else:
+            snes_its = self._timed("velocity", self.mech.solve)                     # G33
+            stats = {"damage_its": damage_its, "snes_its": snes_its}
+        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array          # (3.160)
+        self.profiles.sample(self.zeta, self.t)
+        return stats
+
+    def _interpolate_zeta0(self):
+        """Example 2 selects its initial damage with ``--set initial_damage=a|b``."""
+        choices = self.data.builders.get("zeta0")
+        choice = self.params.extra.get("initial_damage")
+        if choices is not None:
+            if choice not in choices:
+                raise InputError(f"initial_damage must be one of {', '.join(choices)}, "
+                                 f"got {choice!r}")
+            self.data.zeta0 = choices[choice]
+        self.interpolate_zeta0(self.zeta)
+
+    def _timed(self, key, fn, *args):
+        start = time.perf_counter()
+        out = fn(*args)
+        self.timings[key] += time.perf_counter() - start
+        return out
+
+    def update_output(self):
+        compat.interpolate(self.von_mises, self._vm_expr)
+
+    # -- stability of the explicit elastic and contact forces (PROBLEMS.md 1.8)
+    def _stability_check(self, V, x, dsC) -> dict:
+        """k_max of the explicit scheme (undamaged body, Gamma_C fully in contact: conservative)
+        compared with k according to ``stability_check``; {} when off. The implicit variant
+        (G33) is reported against the same k_max but never warned about."""
+        action = x.get("stability_check", "warn")
+        if action == "off":
+            return {}
+        from ..stability import check_time_step, estimate_stability
+        start = time.perf_counter()
+        has_contact = self.comm.allreduce(
+            int(np.sum(self.data.geometry.facet_tags.values == GAMMA_C)), op=MPI.SUM) > 0
+        out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
+                                 c_nu=self.c_nu if has_contact else 0.0, dsC=dsC, bcs=self.bcs,
+                                 normal=self.n_facet)
+        out["k_over_k_max"] = check_time_step(
+            self.k, out["k_max"], f"example {self.data.example_id}",
+            action=action if self.elastic_term == "explicit" else "off")
+        out["time_s"] = time.perf_counter() - start
+        return out
+
+    # -- scalars and summary
+    def scalars(self) -> dict:
+        out = super().scalars()
+        out["v_L2"] = float(np.sqrt(abs(compat.assemble_scalar(self._v_sq, self.comm))))
+        out.update(self.contact(self.u, self.t))
+        out.update(self.probe(self.zeta, self.t, self.params.zeta_star))
+        return out
+
+    def summary_extra(self) -> dict:
+        out = {"k": self.k, "elastic_term": self.elastic_term + (
+            "" if self.elastic_term == "explicit" else " (G33 deviation, not the thesis scheme)")}
+        if self.stability:
+            out.update(k_max=self.stability["k_max"], k_over_k_max=self.stability["k_over_k_max"],
+                       stability=self.stability)
+        out.update(self.contact.summary())
+        out.update(self.probe.summary())
+        out.update(self.profiles.summary(self.zeta, self.t))
+        return out
+
+    def iteration_totals(self) -> dict:
+        out = {"damage_snes": self.damage.iterations if self.damage else 0}
+        if self.elastic_term == "explicit":
+            out.update(mech_ksp=self.mech.iterations, mech_solves=self.mech.solves)
+        else:
+            out.update(snes=self.mech.iterations, mech_ksp=self.mech.linear_iterations)
+        return out
+
+
+# ---------------------------------------------------------------------------- monitors
+class ContactMonitor:
+    """Maximal interpenetration (u.nu - gap)_+ over the vertices of Gamma_C (u is P1, so the
+    maximum over a facet is at a vertex), with nu the outward normal of each facet, and its
+    location; the running maximum over the run goes to summary.json."""
+
+    columns = ["penetration_max", "penetration_x1", "penetration_x2"]
+
+    def __init__(self, V, tags, tag, gap):
+        self.comm, self.gap = V.mesh.comm, gap
+        msh = V.mesh
+        tdim = msh.topology.dim
+        for dim in ((tdim, 0), (tdim - 1, 0), (tdim - 1, tdim)):
+            msh.topology.create_connectivity(*dim)
+        facets = tags.indices[tags.values == tag]
+        c2v = msh.topology.connectivity(tdim, 0)
+        cell_dofs = compat.cell_dofs(V)  # owned cells; P1: the cell's dofs follow its vertices
+        nc, nv = cell_dofs.shape
+        cell_vertices = c2v.array.reshape(-1, nv)[:nc]
+        v2d = np.full(msh.topology.index_map(0).size_local + msh.topology.index_map(0).num_ghosts,
+                      -1, dtype=np.int64)
+        v2d[cell_vertices] = cell_dofs
+        f2v, f2c = msh.topology.connectivity(tdim - 1, 0), msh.topology.connectivity(tdim - 1, tdim)
+        cells = f2c.array[f2c.offsets[facets]]  # exterior facets: their only cell
+        keep = cells < nc  # a facet of a ghost cell is monitored by the rank owning that cell
+        facets, cells = facets[keep], cells[keep]
+        self.dofs = v2d[f2v.array.reshape(-1, 2)[facets]]            # (nf, 2) vertex dofs
+        X = V.tabulate_dof_coordinates()[:, :2]
+        self.X = X[self.dofs]                                          # (nf, 2, 2)
+        cell_mid = X[v2d[cell_vertices[cells]]].mean(axis=1)
+        t = self.X[:, 1] - self.X[:, 0]
+        n = np.stack([t[:, 1], -t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
+        outward = np.einsum("ij,ij->i", n, self.X.mean(axis=1) - cell_mid) > 0
+        self.normal = np.where(outward[:, None], n, -n)
+        self.present = self.comm.allreduce(int(facets.size), op=MPI.SUM) > 0
+        self.worst = {"max_penetration": 0.0, "max_penetration_t": 0.0,
+                      "max_penetration_at": [math.nan, math.nan]}
+
+    def __call__(self, u, t) -> dict:
+        if not self.present:
+            return {}
+        U = u.x.array.reshape(-1, 2)[self.dofs]                       # (nf, 2, 2)
+        pen = np.einsum("fvc,fc->fv", U, self.normal) - self.gap
+        best = (-np.inf, math.nan, math.nan)
+        if pen.size:
+            i, j = np.unravel_index(np.argmax(pen), pen.shape)
+            best = (float(pen[i, j]), *map(float, self.X[i, j]))
+        value, x1, x2 = max(self.comm.allgather(best), key=lambda b: (b[0], -b[1], -b[2]))
+        value = max(value, 0.0)
+        if value > self.worst["max_penetration"]:
+            self.worst = {"max_penetration": value, "max_penetration_t": t,
+                          "max_penetration_at": [x1, x2]}
+        return {"penetration_max": value, "penetration_x1": x1, "penetration_x2": x2}
+
+    def summary(self) -> dict:
+        return dict(self.worst) if self.present else {}
+
+
+class ZetaProbe:
+    """zeta at the vertex nearest to ``point`` (None: no probe) and the first time it reaches
+    zeta_star (Example 2: the corner (0, 6))."""
+
+    def __init__(self, Z, point):
+        self.columns, self.point, self.comm = [], point, Z.mesh.comm
+        self.first_zeta_star_time = None
+        if point is None:
+            return
+        owned = Z.dofmap.index_map.size_local
+        X = Z.tabulate_dof_coordinates()[:owned, :2]
+        dist = np.linalg.norm(X - np.asarray(point, float), axis=1)
+        local = float(dist.min()) if dist.size else np.inf
+        best = self.comm.allreduce(local, op=MPI.MIN)
+        owner = self.comm.allreduce(self.comm.rank if local <= best else self.comm.size, op=MPI.MIN)
+        self.index = int(np.argmin(dist)) if self.comm.rank == owner else None
+        self.location = self.comm.bcast(X[self.index].tolist() if self.index is not None else None,
+                                        root=owner)
+        self.columns = ["zeta_probe"]
+
+    def __call__(self, zeta, t, zeta_star) -> dict:
+        if self.point is None:
+            return {}
+        value = float(zeta.x.array[self.index]) if self.index is not None else 0.0
+        value = self.comm.allreduce(value, op=MPI.SUM)
+        if self.first_zeta_star_time is None and value <= zeta_star + 1e-12:
+            self.first_zeta_star_time = t
+        return {"zeta_probe": value}
+
+    def summary(self) -> dict:
+        if self.point is None:
+            return {}
+        return {"probe": self.location, "probe_zeta_star_time": self.first_zeta_star_time}
+
+
+class DamageProfiles:
+    """Nodal values of zeta on the horizontal grid line x_2 = ``x2`` (structured meshes: the
+    vertices on the line), kept every ``every`` seconds of model time; None: off."""
+
+    def __init__(self, Z, x2, every, k):
+        self.x2, self.every, self.k, self.comm = x2, every, k, Z.mesh.comm
+        self.times, self.values = [], []
+        if x2 is None:
+            return
+        owned = Z.dofmap.index_map.size_local
+        X = Z.tabulate_dof_coordinates()[:owned, :2]
+        self.index = np.flatnonzero(np.abs(X[:, 1] - x2) <= 1e-10 * max(1.0, abs(x2)))
+        x1 = np.concatenate(self.comm.allgather(X[self.index, 0]))
+        self.order = np.argsort(x1, kind="stable")
+        self.x1 = x1[self.order]
+        if self.x1.size == 0:
+            raise InputError(f"no mesh vertices on the profile line x2 = {x2}")
+
+    def _values(self, zeta):
+        return np.concatenate(self.comm.allgather(zeta.x.array[self.index]))[self.order]
+
+    def sample(self, zeta, t):
+        if self.x2 is None:
+            return
+        if abs(t / self.every - round(t / self.every)) * self.every < 0.5 * self.k:
+            self.times.append(t)
+            self.values.append(self._values(zeta).tolist())
+
+    def summary(self, zeta, t) -> dict:
+        if self.x2 is None:
+            return {}
+        return {"profiles": {"x2": self.x2, "x1": self.x1.tolist(), "times": list(self.times),
+                             "zeta": list(self.values), "last_t": t,
+                             "last_zeta": self._values(zeta).tolist()}}

@@ -1,0 +1,87 @@
+"""Section 3.3: dynamic, fully damageable frictionless contact, velocity step (3.159):
+
+    (rho (v_n - v_{n-1})/k, w)_H + (zeta_n A eps(v_n), eps(w))_Q
+        + (E(eps(u_{n-1}), zeta_{n-1}), eps(w))_Q + j(zeta_{n-1}, u_{n-1}, w) = <f_n, w>,
+
+A = B / m_visc, E(eps, zeta) = eta_*(zeta) Phi_L(B eps) (3.111), j(zeta, u, w) =
+int_{Gamma_C} eta_*(zeta) p_nu(u.nu - gap) w.nu ds (3.121) with p_nu(r) = c_nu r_+. The damage
+scales the viscosity (with the NEW zeta_n, (3.159)), the elasticity and the contact pressure
+(both with zeta_{n-1}). On K^h (zeta_star <= zeta <= 1 at the vertices) eta_*(zeta) = zeta,
+so writing eta_* changes nothing in the scheme and keeps the forms meaningful for any input.
+
+The non-thesis option ``elastic_term="implicit"`` (G33) evaluates the elastic and contact forces
+at u_n = u_{n-1} + k v_n instead of u_{n-1}: unconditionally stable, for fast qualitative runs
+only; the step is then nonlinear (semismooth in the contact term) and returned as a residual.
+"""
+import ufl
+
+from damage_dolfinx.constitutive import B_plane_stress, Phi_L, eps, eta_star
+from damage_dolfinx.contact import positive_part
+
+from .elastic_damage import load
+
+#: quadrature degree of the truncated (Phi_L, eta_*) and positive-part (contact) terms (G38)
+NONLINEAR_DEGREE = 2
+
+
+def _measures(dsC):
+    """(dx, dsC) with the quadrature degree of the non-polynomial terms."""
+    metadata = {"quadrature_degree": NONLINEAR_DEGREE}
+    return ufl.dx(metadata=metadata), dsC(metadata=metadata)
+
+
+def damaged_viscous_stress(v, zeta, E, nu, m_visc, zeta_star):
+    """eta_*(zeta) A eps(v), A = B / m_visc (3.111, 3.122)."""
+    return eta_star(zeta, zeta_star) * B_plane_stress(eps(v), E, nu) / m_visc
+
+
+def damaged_elastic_stress(u, zeta, E, nu, L_trunc, zeta_star):
+    """E(eps(u), eta_*(zeta)) = eta_*(zeta) Phi_L(B eps(u)) (3.111, 2.106)."""
+    return eta_star(zeta, zeta_star) * Phi_L(B_plane_stress(eps(u), E, nu), L_trunc)
+
+
+def total_stress(v, u, zeta, E, nu, m_visc, L_trunc, zeta_star):
+    """sigma_n = eta_*(zeta_n) (A eps(v_n) + Phi_L(B eps(u_n))) (3.111; von Mises, 1.9)."""
+    return (damaged_viscous_stress(v, zeta, E, nu, m_visc, zeta_star)
+            + damaged_elastic_stress(u, zeta, E, nu, L_trunc, zeta_star))
+
+
+def damaged_contact_pressure(u, zeta, n, c_nu, gap, zeta_star):
+    """eta_*(zeta) p_nu(u.nu - gap) = eta_*(zeta) c_nu (u.nu - gap)_+ (3.116)."""
+    return eta_star(zeta, zeta_star) * c_nu * positive_part(ufl.dot(u, n) - gap)
+
+
+def velocity_step_forms(v, w, v_old, u_old, zeta_new, zeta_old, rho, k, E, nu, m_visc, L_trunc,
+                        zeta_star, c_nu, gap, n, f_B, f_N, dsN, dsC):
+    """(a, l) of the linear system (3.159): v, w trial/test functions of V^h; v_old, u_old,
+    zeta_old at step n-1, zeta_new = zeta_n from the damage step (3.158)."""
+    dx = ufl.dx
+    dxq, dsq = _measures(dsC)
+    sigma_visc = damaged_viscous_stress(v, zeta_new, E, nu, m_visc, zeta_star)       # zeta_n A eps(v_n)
+    sigma_el = damaged_elastic_stress(u_old, zeta_old, E, nu, L_trunc, zeta_star)   # E(eps(u_{n-1}), zeta_{n-1})
+    p_c = damaged_contact_pressure(u_old, zeta_old, n, c_nu, gap, zeta_star)        # zeta_{n-1} p_nu(u_{n-1}.nu - g)
+    a = (rho / k * ufl.inner(v, w) * dx              # (3.159) (rho delta v_n, w)_H, v_n part
+         + ufl.inner(sigma_visc, eps(w)) * dx)        # (3.159) (zeta_n A eps(v_n), eps(w))_Q
+    l = (rho / k * ufl.inner(v_old, w) * dx          # (3.159) (rho delta v_n, w)_H, v_{n-1} part
+         - ufl.inner(sigma_el, eps(w)) * dxq          # (3.159) (E(eps(u_{n-1}), zeta_{n-1}), eps(w))_Q
+         - p_c * ufl.dot(w, n) * dsq)                 # (3.159) j(zeta_{n-1}, u_{n-1}, w)
+    L = load(w, f_B, f_N, dsN)                        # (3.159) <f_n, w>
+    return a, (l if L is None else l + L)
+
+
+def implicit_velocity_residual(v, w, v_old, u_old, zeta_new, zeta_old, rho, k, E, nu, m_visc,
+                               L_trunc, zeta_star, c_nu, gap, n, f_B, f_N, dsN, dsC):
+    """F(v; w) of the G33 deviation: (3.159) with u_{n-1} replaced by u_{n-1} + k v_n in the
+    elastic and contact forces (damage factors still zeta_{n-1}); v is the unknown Function."""
+    dx = ufl.dx
+    dxq, dsq = _measures(dsC)
+    u_new = u_old + k * v
+    sigma_visc = damaged_viscous_stress(v, zeta_new, E, nu, m_visc, zeta_star)       # zeta_n A eps(v_n)
+    sigma_el = damaged_elastic_stress(u_new, zeta_old, E, nu, L_trunc, zeta_star)   # G33: at u_n
+    p_c = damaged_contact_pressure(u_new, zeta_old, n, c_nu, gap, zeta_star)        # G33: at u_n
+    F = (rho / k * ufl.inner(v - v_old, w) * dx      # (3.159) (rho delta v_n, w)_H
+         + ufl.inner(sigma_visc, eps(w)) * dx         # (3.159) (zeta_n A eps(v_n), eps(w))_Q
+         + ufl.inner(sigma_el, eps(w)) * dxq          # G33: (E(eps(u_n), zeta_{n-1}), eps(w))_Q
+         + p_c * ufl.dot(w, n) * dsq)                 # G33: j(zeta_{n-1}, u_n, w)
+    L = load(w, f_B, f_N, dsN)                        # (3.159) <f_n, w>
+    return F if L is None else F - L
