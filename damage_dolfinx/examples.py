@@ -23,6 +23,7 @@ class Figure:
     kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh) or
     #                                        "history" (fields = ((column, label), ...) of history.csv)
     times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
+    mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
 
 
 @dataclass

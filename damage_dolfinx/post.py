@@ -136,9 +136,10 @@ def gather_cells(u_disp, field, amplification: float = 0.0):
     return np.concatenate(xy_all), np.concatenate(val_all)
 
 
-def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None):
+def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None, mesh_lines=False):
     """One PNG with a panel per (Function, label) in ``fields``, on the configuration
-    x + amplification * u (PROBLEMS.md 1.9); collective, rank 0 draws."""
+    x + amplification * u (PROBLEMS.md 1.9), with the deformed mesh edges if ``mesh_lines``
+    (the thesis's "deformed mesh" figures); collective, rank 0 draws."""
     gathered = [(gather_cells(u_disp, f, amplification), label) for f, label in fields]
     # optional colour range of a field: attribute ``plot_range = (vmin, vmax)`` on the Function
     ranges = [getattr(f, "plot_range", None) or (None, None) for f, _ in fields]
@@ -159,6 +160,8 @@ def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None)
                               vmin=vmin, vmax=vmax)
         else:
             im = ax.tripcolor(tri, facecolors=vals, cmap="viridis", vmin=vmin, vmax=vmax)
+        if mesh_lines:
+            ax.triplot(tri, color="k", lw=0.15, alpha=0.6)
         if ref is not None:
             _draw_outline(ax, ref[0])
         ax.set_aspect("equal")
@@ -171,7 +174,7 @@ def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None)
     lines = textwrap.wrap(title + suffix, width=50 * len(gathered))  # no clipping on 1 panel
     fig.suptitle("\n".join(lines), fontsize=11)
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.045 * len(lines)))
-    fig.savefig(path, dpi=130)
+    fig.savefig(path, dpi=130, bbox_inches="tight")
     plt.close(fig)
 
 

@@ -228,5 +228,6 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
     fields.update(getattr(stepper, "figure_fields", {}))  # problem-specific (name: (Function, label))
     amp = fig.amplification or auto_amplification(stepper, ex.diameter)
     post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / filename,
-                     amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True)
+                     amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True,
+                     mesh_lines=fig.mesh_lines)
     return {"file": filename, "t": stepper.t, "amplification": amp}

@@ -76,7 +76,7 @@ def examples():
             "probe at x = (4, 0): horizontal displacement and tangential stress sigma_tau "
             "= (a(v, .) - l)_i . tau_i / m_i (the nodal friction force)"],
         figures=[Figure("figure_2_12_left.png", "Example 2.2-3: deformed mesh", fields=("zeta",),
-                        amplification=3.0),
+                        amplification=3.0, mesh_lines=True),
                  Figure("figure_2_12_right.png", "Example 2.2-3: history at x = (4, 0)",
                         kind="history", fields=(("probe_u1", "u_1(4, 0) [m]"),
                                                 ("probe_sigma_tau", "sigma_tau(4, 0) [Pa]"))),

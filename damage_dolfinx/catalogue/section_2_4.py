@@ -71,6 +71,7 @@ def examples():
             "G42: Gamma_D empty: the stuck contact side (Jacobian of Phi_eps) fixes the body; "
             "direct solver"],
         figures=[Figure("figure_2_26.png", "Example 2.4-2: setting and mesh", kind="mesh"),
-                 Figure("figure_2_27.png", "Example 2.4-2: deformed mesh", fields=("zeta",)),
+                 Figure("figure_2_27.png", "Example 2.4-2: deformed mesh", fields=("zeta",),
+                        mesh_lines=True),
                  Figure("figure_2_28.png", "Example 2.4-2: von Mises stress and damage")])
     return [ex1, ex2]

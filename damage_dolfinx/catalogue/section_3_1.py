@@ -98,7 +98,7 @@ def examples():
             "t = 0.45 on, max |u| ~ 0.8 m at t = 1 (far beyond small strains)"],
         figures=[Figure("figure_3_3.png", "Example 3.1-2: setting and mesh", kind="mesh"),
                  Figure("figure_3_4.png", "Example 3.1-2: deformed mesh and initial outline",
-                        fields=("zeta",), amplification=4.0),
+                        fields=("zeta",), amplification=4.0, mesh_lines=True),
                  Figure("figure_3_5.png", "Example 3.1-2: von Mises stress and damage",
                         amplification=4.0)])
 
@@ -126,7 +126,7 @@ def examples():
             "benchmarks/lshape_3_1.py draws both runs side by side"],
         figures=[Figure("figure_3_6.png", "Example 3.1-3: setting and mesh", kind="mesh"),
                  Figure("figure_3_7.png", "Example 3.1-3: deformed mesh and initial outline",
-                        fields=("zeta",), amplification=10.0),
+                        fields=("zeta",), amplification=10.0, mesh_lines=True),
                  Figure("figure_3_8.png", "Example 3.1-3: von Mises norm of the strain",
                         fields=("von_mises_strain",), amplification=10.0)])
     return [ex1, ex2, ex3]

@@ -88,7 +88,7 @@ def examples():
             "term makes a coercive, the ||eps(.)|| stopping test of friction.py does not see "
             "rigid translations (measured: stops after one iteration at n = 4, never at n = 20)"],
         figures=[Figure("figure_3_11.png", "Example 3.2-2: deformed mesh", fields=("zeta",),
-                        amplification=5.0),
+                        amplification=5.0, mesh_lines=True),
                  Figure("figure_3_12.png", "Example 3.2-2: von Mises stress and damage"),
                  Figure("figure_3_11_history.png", "Example 3.2-2: tangential displacements",
                         kind="history",
@@ -111,6 +111,7 @@ def examples():
             "G40: amplification of Figure 3.13 not given: largest displacement = 10% of the "
             "diameter"],
         figures=[Figure("figure_3_13_left.png", "Example 3.2-3: setting and mesh", kind="mesh"),
-                 Figure("figure_3_13.png", "Example 3.2-3: deformed mesh", fields=("zeta",)),
+                 Figure("figure_3_13.png", "Example 3.2-3: deformed mesh", fields=("zeta",),
+                        mesh_lines=True),
                  Figure("figure_3_14.png", "Example 3.2-3: von Mises stress and damage")])
     return [ex1, ex2, ex3]

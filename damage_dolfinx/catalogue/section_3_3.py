@@ -158,12 +158,12 @@ def examples():
             "1.37e-5 at h = 0.15 (stability helper, omega_max^2 = 2.5e10, inertia-limited by the "
             "h/3 = 0.05 elements at the hexagon), 0.8 k_max = 1.09e-5, rounded down to a divisor "
             "of T",
-            "figures: x2 deformed configuration with the initial outline (Figure 3.20 as "
-            "coloured fields; benchmarks/wrench_3_3.py also draws the deformed wire mesh), von "
+            "figures: x2 deformed mesh with the initial outline (Figure 3.20, edges over the "
+            "damage field; benchmarks/wrench_3_3.py also draws the bare wire mesh), von "
             "Mises (3.21) and damage (3.22) at T"],
         figures=[Figure("figure_3_19.png", "Example 3.3-3: setting and mesh", kind="mesh"),
                  Figure("figure_3_20.png", "Example 3.3-3: deformed configuration (x2)",
-                        fields=("zeta",), amplification=2.0),
+                        fields=("zeta",), amplification=2.0, mesh_lines=True),
                  Figure("figure_3_21.png", "Example 3.3-3: von Mises stress",
                         fields=("von_mises",), amplification=2.0),
                  Figure("figure_3_22.png", "Example 3.3-3: damage on the deformed shape",
