@@ -1,6 +1,7 @@
 """What every problem's time stepper shares: data, state, scalars for the history."""
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Union
 
@@ -107,6 +108,13 @@ class TimeStepper:
         return None
 
     # -- helpers for subclasses
+    def _timed(self, key, fn, *args):
+        """fn(*args), its wall time added to self.timings[key]."""
+        start = time.perf_counter()
+        out = fn(*args)
+        self.timings[key] += time.perf_counter() - start
+        return out
+
     def interpolate_zeta0(self, zeta):
         z0 = self.data.zeta0
         if callable(z0):

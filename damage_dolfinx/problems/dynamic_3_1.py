@@ -110,12 +110,6 @@ class DynamicKelvinVoigt(TimeStepper):
         self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array            # (3.51)
         return {"damage_its": damage_its, "mech_its": mech_its}
 
-    def _timed(self, key, fn, *args):
-        start = time.perf_counter()
-        out = fn(*args)
-        self.timings[key] += time.perf_counter() - start
-        return out
-
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
         compat.interpolate(self.von_mises_strain, self._vm_strain_expr)

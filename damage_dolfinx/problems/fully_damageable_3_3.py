@@ -157,12 +157,6 @@ class FullyDamageableContact(TimeStepper):
             self.data.zeta0 = choices[choice]
         self.interpolate_zeta0(self.zeta)
 
-    def _timed(self, key, fn, *args):
-        start = time.perf_counter()
-        out = fn(*args)
-        self.timings[key] += time.perf_counter() - start
-        return out
-
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
 

@@ -12,7 +12,6 @@ and exponential kernels (memory.py).
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import ufl
@@ -105,12 +104,6 @@ class ViscoelasticMemoryContact(TimeStepper):
         damage_its = self._timed("damage", self.damage.solve)
         mech_its = self._timed("mech", self.mech.solve)
         return {"damage_its": damage_its, "snes_its": mech_its}
-
-    def _timed(self, key, fn, *args):
-        start = time.perf_counter()
-        out = fn(*args)
-        self.timings[key] += time.perf_counter() - start
-        return out
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
