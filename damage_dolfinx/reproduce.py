@@ -35,8 +35,10 @@ CONVERGENCE_FIGURES = {
     ("3.1-ex1", ""): "figure_3_2", ("3.2-ex1", ""): "table_3_2_plot", ("3.3-ex1", ""): "figure_3_16",
 }
 
-#: examples whose figures come from the catalogue run alone; the bridge has its own benchmark
-SKIP_RUN = {"2.2-ex2"}  # same physics as 2.2-ex1, only a convergence table
+#: same physics as 2.2-ex1, only a convergence table
+SKIP_RUN = {"2.2-ex2"}
+#: small meshes with very many steps: one rank is faster (measured: 1.7 vs 8 ms per step)
+SERIAL = {"3.3-ex2", "3.3-ex3"}
 
 
 @dataclass
@@ -138,8 +140,9 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None) -> dict:
             shutil.rmtree(run_dir)
         run_dir.mkdir(parents=True)
         command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir)]
-        code, wall, _ = _launch(command, np_, run_dir / "log.txt")
-        entry = {"example": job.example, "variant": job.variant, "command": _display(command, np_),
+        ranks = 1 if job.example in SERIAL else np_
+        code, wall, _ = _launch(command, ranks, run_dir / "log.txt")
+        entry = {"example": job.example, "variant": job.variant, "command": _display(command, ranks),
                  "returncode": code, "wall_time_s": round(wall, 2), "folder": str(run_dir)}
         summary = run_dir / "summary.json"
         if summary.is_file():
