@@ -121,6 +121,14 @@ def _launch(command: list, np_: int, log: Path) -> tuple:
     return code, time.perf_counter() - start, argv
 
 
+def _figure_name(file: str, job: Job) -> str:
+    """Thesis figures keep their number (plus the variant); other PNGs get the example id."""
+    stem = Path(file).stem
+    if not stem.startswith("figure_"):
+        stem = f"{job.example}_{stem}"
+    return stem + (f"_{job.variant}" if job.variant else "") + ".png"
+
+
 def _display(command: list, np_: int) -> str:
     """The command as a user types it."""
     return (f"mpirun -n {np_} " if np_ > 1 else "") + "damage-dolfinx " + " ".join(command)
@@ -150,7 +158,7 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None) -> dict:
             entry.update(status=s.get("status"), title=s.get("title"),
                          figures=[f["file"] for f in s["outputs"]["figures"]])
             for fig in s["outputs"]["figures"]:
-                target = Path(fig["file"]).stem + (f"_{job.variant}" if job.variant else "") + ".png"
+                target = _figure_name(fig["file"], job)
                 shutil.copy(run_dir / fig["file"], out / target)
                 index["figures"].append({"file": target, "example": job.example,
                                          "variant": job.variant, "title": s.get("title"),
