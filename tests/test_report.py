@@ -25,7 +25,7 @@ def test_quick_figures_and_report(tmp_path):
     index = reproduce.run_figures("quick", tmp_path / "figures", np_=1, only=["2.3-ex1"])
     assert [r["returncode"] for r in index["runs"]] == [0]
     files = {f["file"] for f in index["figures"]}
-    assert {"figure_2_14.png", "fields_final.png"} <= files
+    assert {"figure_2_14.png", "2.3-ex1_fields_final.png"} <= files
     page = report.build(tmp_path)
     md = (tmp_path / "REPORT.md").read_text()
     assert "damage-dolfinx run 2.3-ex1" in md          # traceable to its command
