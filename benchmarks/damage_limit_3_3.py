@@ -22,7 +22,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from damage_dolfinx import examples, runner
+from damage_dolfinx import examples, post, runner
 
 EXAMPLE = "3.3-ex2"
 FIGURES = {"a": "figure_3_17.png", "b": "figure_3_18.png"}
@@ -64,35 +64,6 @@ def write_csv(path, header, rows):
         w.writerows(rows)
 
 
-def plot(case, prof, t, z, zeta_star, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
-    cmap = plt.get_cmap("viridis")
-    curves = list(zip(prof["times"], prof["zeta"])) + [(prof["last_t"], prof["last_zeta"])]
-    for i, (ti, zi) in enumerate(curves):
-        last = i == len(curves) - 1
-        left.plot(prof["x1"], zi, ls="--" if last else "-", lw=1.2,
-                  color="k" if last else cmap(i / max(1, len(curves) - 1)),
-                  label=f"t = {ti:.3g}" + (" (last)" if last else ""))
-    left.set_xlabel("x1 [m]")
-    left.set_ylabel(f"zeta on x2 = {prof['x2']:g}")
-    left.set_ylim(0, 1.05)
-    left.grid(True, alpha=0.3)
-    left.legend(fontsize=7, ncol=2)
-    right.plot(t, z, lw=1.0)
-    right.axhline(zeta_star, color="r", lw=0.8, ls=":", label="zeta_star")
-    right.set_xlabel("t [s]")
-    right.set_ylabel("zeta(0, 6)")
-    right.grid(True, alpha=0.3)
-    right.legend(fontsize=8)
-    fig.suptitle(f"Example 3.3-2 ({case}): damage profiles and damage at the corner (0, 6)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-
-
 k_max = None
 k = args.k
 if k is None:
@@ -114,7 +85,8 @@ for case in args.cases:
               [[ti] + zi for ti, zi in zip(prof["times"], prof["zeta"])]
               + [[prof["last_t"]] + prof["last_zeta"]])
     write_csv(out / f"corner_{case}.csv", ["t", "zeta_0_6"], list(zip(t, z)))
-    plot(case, prof, t, z, zeta_star, out / FIGURES[case])
+    post.plot_damage_profiles(prof, out / case / "history.csv", zeta_star, out / FIGURES[case],
+                              f"Example 3.3-2 ({case}): damage profiles and damage at the corner (0, 6)")
     results[case] = {
         "n": args.n, "k": k, "k_max": summary.get("k_max", k_max), "elastic_term": args.elastic_term,
         "status": summary["status"], "t_stop": summary["t_final"],

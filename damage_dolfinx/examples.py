@@ -20,8 +20,9 @@ class Figure:
     title: str
     fields: tuple = ("von_mises", "zeta")
     amplification: Optional[float] = None  # None: largest displacement = 10% of diameter (G40)
-    kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh) or
+    kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh),
     #                                        "history" (fields = ((column, label), ...) of history.csv)
+    #                                        or "profiles" (summary "profiles" + zeta_probe, 3.3-ex2)
     times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
     mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
 

@@ -252,3 +252,41 @@ def plot_history(csv_path, columns, path, title=""):
     fig.tight_layout()
     fig.savefig(path, dpi=130)
     plt.close(fig)
+
+
+def plot_damage_profiles(prof, history_csv, zeta_star, path, title, probe_column="zeta_probe",
+                         probe_label="zeta(0, 6)"):
+    """Thesis Figures 3.17/3.18: zeta along a line at several times (``prof`` = the stepper's
+    {"x1", "x2", "times", "zeta", "last_t", "last_zeta"}) and the probe history from
+    history.csv with the zeta_star line (rank 0 only)."""
+    import csv
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    with open(history_csv) as f:
+        rows = list(csv.DictReader(f))
+    t = [float(r["t"]) for r in rows]
+    z = [float(r[probe_column]) for r in rows]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    cmap = plt.get_cmap("viridis")
+    curves = list(zip(prof["times"], prof["zeta"])) + [(prof["last_t"], prof["last_zeta"])]
+    for i, (ti, zi) in enumerate(curves):
+        last = i == len(curves) - 1
+        left.plot(prof["x1"], zi, ls="--" if last else "-", lw=1.2,
+                  color="k" if last else cmap(i / max(1, len(curves) - 1)),
+                  label=f"t = {ti:.3g}" + (" (last)" if last else ""))
+    left.set_xlabel("x1 [m]")
+    left.set_ylabel(f"zeta on x2 = {prof['x2']:g}")
+    left.set_ylim(0, 1.05)
+    left.grid(True, alpha=0.3)
+    left.legend(fontsize=7, ncol=2)
+    right.plot(t, z, lw=1.0)
+    right.axhline(zeta_star, color="r", lw=0.8, ls=":", label="zeta_star")
+    right.set_xlabel("t [s]")
+    right.set_ylabel(probe_label)
+    right.grid(True, alpha=0.3)
+    right.legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130, bbox_inches="tight")
+    plt.close(fig)

@@ -218,6 +218,11 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
         if stepper.comm.rank == 0:
             post.plot_history(out / "history.csv", fig.fields, out / filename, title=fig.title)
         return {"file": filename}
+    if fig.kind == "profiles":  # damage along a line at several times + probe history
+        if stepper.comm.rank == 0:
+            post.plot_damage_profiles(stepper.summary_extra()["profiles"], out / "history.csv",
+                                      stepper.params.zeta_star, out / filename, fig.title)
+        return {"file": filename}
     if fig.kind == "mesh":
         post.plot_mesh(stepper.data.geometry, out / filename, title=fig.title,
                        labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",

@@ -123,9 +123,12 @@ def examples():
             "to a divisor of 0.5 s; other n need their own k (n = 8: k_max = 1.8e-4; the run "
             "warns when k > k_max)",
             "G34: profiles of zeta along x2 = 3 (a) or x2 = 0 (b) every 0.5 s plus the last step "
-            "(summary.json 'profiles'; benchmarks/damage_limit_3_3.py draws Figures 3.17/3.18); "
+            "(summary.json 'profiles', drawn as figure_3_17_18.png; benchmarks/damage_limit_3_3.py "
+            "also picks k and reports the mending); "
             "zeta(0,6) vs t is the history column zeta_probe"],
-        figures=[Figure("zeta_corner_history.png",
+        figures=[Figure("figure_3_17_18.png", "Example 3.3-2: damage profiles and damage at "
+                        "(0, 6) (Figure 3.17 for initial damage a, 3.18 for b)", kind="profiles"),
+                 Figure("zeta_corner_history.png",
                         "Example 3.3-2: damage at (0, 6) (Figures 3.17/3.18, right)",
                         fields=(("zeta_probe", "zeta(0, 6)"), ("zeta_min", "min zeta")),
                         kind="history"),
