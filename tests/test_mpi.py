@@ -37,3 +37,17 @@ def test_convergence_table_serial_equals_two_ranks(tmp_path):
     assert errs[0] > errs[1] > 0
     for name in ("errors.csv", "errors.md", "convergence.png"):
         assert (tmp_path / "p" / name).exists()
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("args", [
+    ["2.4-ex2", "--n", "8", "--k", "0.02", "--T", "0.2"],
+    ["3.1-ex2", "--n", "5", "--T", "0.04"],
+    ["3.2-ex3", "--n", "5", "--T", "0.05"],
+    ["3.3-ex2", "--n", "4", "--k", "2.5e-4", "--T", "0.05", "--set", "initial_damage=b"],
+], ids=lambda a: a[0])
+def test_remaining_examples_serial_equals_two_ranks(tmp_path, args):
+    """Every catalogue example gives the same fields on 1 and 2 ranks (the others are checked
+    in their own test files)."""
+    from conftest import serial_and_two_ranks
+    serial_and_two_ranks(tmp_path, ["run", *args, "--no-figures", "--quiet"])
