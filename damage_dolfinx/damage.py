@@ -13,7 +13,7 @@ from petsc4py import PETSc
 from . import compat
 from .constitutive import Psi_q, eta_star, split_norms_sq
 from .forms.damage import damage_step_forms
-from .solvers import LinearSolver, SNESSolver, SolveContext
+from .solvers import ConvergenceError, LinearSolver, SNESSolver, SolveContext
 
 
 def phi_A(e, z, p):
@@ -49,6 +49,10 @@ OBSTACLE_DEFAULTS = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_atol
                      "ksp_max_it": 1000}
 
 
+#: absolute SNES tolerance of the obstacle step relative to ||l|| (the CG accuracy)
+OBSTACLE_ATOL_REL = 1e-11
+
+
 class DamageStep:
     """zeta_n from b(zeta_n, xi) = l(xi) (PDE) or the VI b(zeta_n, xi - zeta_n) >= l(xi - zeta_n).
 
@@ -78,6 +82,8 @@ class DamageStep:
         self.snes = SNESSolver(V.mesh.comm, prefix, context, self._residual, self._jacobian,
                                self.b.duplicate(), self.A, OBSTACLE_DEFAULTS,
                                bounds=(self.lower, self.upper))
+        self._atol = self.snes.snes.getTolerances()[1]
+        self.lu_retries = 0
 
     def _residual(self, x, f):
         """F(z) = B z - l: the damage step is affine, so no re-assembly inside Newton."""
@@ -95,10 +101,29 @@ class DamageStep:
             bl.set(0.0)
         compat.assemble_vector(self.b, self.L)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
+        # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
+        self.snes.snes.setTolerances(atol=max(self._atol, OBSTACLE_ATOL_REL * self.b.norm()))
         self.zeta.x.array[:] = self.zeta_old.x.array
-        its = self.snes.solve(compat.petsc_vec(self.zeta))
+        try:
+            its = self.snes.solve(compat.petsc_vec(self.zeta))
+        except ConvergenceError:  # active-set cycling with inexact CG: once more with LU
+            self.lu_retries += 1
+            self.zeta.x.array[:] = self.zeta_old.x.array
+            its = self._solve_with_lu()
         self.zeta.x.scatter_forward()
         return its
+
+    def _solve_with_lu(self) -> int:
+        ksp = self.snes.snes.getKSP()
+        ksp_type, pc_type = ksp.getType(), ksp.getPC().getType()
+        ksp.setType("preonly")
+        ksp.getPC().setType("lu")
+        try:
+            return self.snes.solve(compat.petsc_vec(self.zeta))
+        finally:
+            ksp.setType(ksp_type)
+            ksp.getPC().setType(pc_type)
 
     @property
     def iterations(self) -> int:
