@@ -41,12 +41,27 @@ def _reason_name(enum, reason: int) -> str:
     return str(reason)
 
 
+#: options this module put into the PETSc database (full name -> value), as opposed to options
+#: the user gave (command line, -prefix_option value), which always win
+_CODE_DEFAULTS = {}
+
+
 def set_default_options(prefix: str, defaults: dict):
-    """Put ``defaults`` under ``prefix`` in the PETSc options database unless already set."""
+    """Put ``defaults`` under ``prefix`` in the PETSc options database; options the user set
+    are kept. Code defaults of an earlier solver with the same prefix (several problems in one
+    process, e.g. the tests) are replaced, and those the new defaults do not name are removed,
+    so that one solver's defaults never leak into another's (e.g. a nonzero initial guess into
+    a preonly LU solve)."""
     opts = PETSc.Options()
+    for name in [n for n in _CODE_DEFAULTS if n.startswith(prefix)]:
+        if name[len(prefix):] not in defaults:
+            opts.delValue(name)
+            del _CODE_DEFAULTS[name]
     for key, value in defaults.items():
-        if not opts.hasName(prefix + key):
-            opts[prefix + key] = value
+        name = prefix + key
+        if name in _CODE_DEFAULTS or not opts.hasName(name):
+            opts[name] = value
+            _CODE_DEFAULTS[name] = value
 
 
 #: direct solve, factorisation reused while the matrix is unchanged

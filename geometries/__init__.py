@@ -41,6 +41,21 @@ def gmsh_session():
     return gmsh
 
 
+def generate_2d(h):
+    """Mesh the current gmsh model in 2D with element size h (transfinite curves ignore it); the
+    global size options are restored afterwards."""
+    gmsh = gmsh_session()
+    names = ("Mesh.MeshSizeMin", "Mesh.MeshSizeMax")
+    saved = [gmsh.option.getNumber(n) for n in names]
+    for n in names:
+        gmsh.option.setNumber(n, h)
+    try:
+        gmsh.model.mesh.generate(2)
+    finally:
+        for n, v in zip(names, saved):
+            gmsh.option.setNumber(n, v)
+
+
 def read_msh(comm, path) -> Geometry:
     """A gmsh .msh file whose physical curve tags follow GAMMA_D/GAMMA_N/GAMMA_C."""
     from damage_dolfinx import compat

@@ -29,7 +29,7 @@ import numpy as np
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_D, GAMMA_N, Geometry, gmsh_session
+from . import GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
 
 #: traction-free exterior faces
 FREE = 4
@@ -136,7 +136,7 @@ def arch_bridge(comm, h: float = 0.05, span: float = SPAN, rise: float = RISE,
         gmsh_session()
         gmsh.model.add("arch_bridge")
         _build_model(geo, diagonal, fill, cover, abutments, abutment_height)
-        _generate(geo.h)
+        generate_2d(geo.h)
     geo.mesh, _, geo.facet_tags = compat.model_to_mesh(gmsh.model, comm, 0, gdim=2)
     if comm.rank == 0:
         gmsh.model.remove()
@@ -148,18 +148,6 @@ def arch_bridge(comm, h: float = 0.05, span: float = SPAN, rise: float = RISE,
                        + (", with fill" if fill else "") + (", with abutments" if abutments else ""))
     return geo
 
-
-def _generate(h):
-    """Mesh with sizes h everywhere (transfinite curves ignore it); global options restored."""
-    names = ("Mesh.MeshSizeMin", "Mesh.MeshSizeMax")
-    saved = [gmsh.option.getNumber(n) for n in names]
-    for n in names:
-        gmsh.option.setNumber(n, h)
-    try:
-        gmsh.model.mesh.generate(2)
-    finally:
-        for n, v in zip(names, saved):
-            gmsh.option.setNumber(n, v)
 
 
 def _patch_sections(geo: ArchGeometry):

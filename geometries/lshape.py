@@ -11,7 +11,7 @@ import gmsh
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_C, GAMMA_D, GAMMA_N, Geometry, gmsh_session
+from . import GAMMA_C, GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
 
 #: traction-free sides
 FREE = 4
@@ -35,22 +35,9 @@ def lshape(comm, h: float = 1.0 / 32.0) -> Geometry:
         gmsh.model.addPhysicalGroup(2, [surface], 1)
         for tag in (GAMMA_D, GAMMA_N, GAMMA_C, FREE):
             gmsh.model.addPhysicalGroup(1, [c for c, t in zip(lines, SIDE_TAGS) if t == tag], tag)
-        _generate(h)
+        generate_2d(h)
     msh, _, facet_tags = compat.model_to_mesh(gmsh.model, comm, 0, gdim=2)
     if comm.rank == 0:
         gmsh.model.remove()
     return Geometry(msh, facet_tags, h=h,
                     description=f"inverted L (0,2)^2 minus [1,2]x[0,1), gmsh h = {h:.4g} (G26)")
-
-
-def _generate(h):
-    """Mesh with size h everywhere; the global size options are restored afterwards."""
-    names = ("Mesh.MeshSizeMin", "Mesh.MeshSizeMax")
-    saved = [gmsh.option.getNumber(n) for n in names]
-    for n in names:
-        gmsh.option.setNumber(n, h)
-    try:
-        gmsh.model.mesh.generate(2)
-    finally:
-        for n, v in zip(names, saved):
-            gmsh.option.setNumber(n, v)

@@ -108,6 +108,17 @@ class TimeStepper:
         return None
 
     # -- helpers for subclasses
+    def obstacle_damage_step(self, prefix="damage_"):
+        """The damage inclusion step of 2.2, 2.4 and 3.1-3.3 (PROBLEMS.md 1.4): zeta_n in K^h from
+        zeta_{n-1} and the explicit source phi(eps(u_{n-1}), zeta_{n-1}), SNES vinewtonrsls.
+        Needs ``self.u_old``, ``self.zeta`` and ``self.zeta_old``."""
+        from ..damage import DamageStep, source
+        p, msh = self.params, self.mesh
+        phi_old = source(eps(self.u_old), self.zeta_old, p)
+        return DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.data.time.k),
+                          fem.Constant(msh, float(p.kappa)), self.context, obstacle=True,
+                          zeta_star=p.zeta_star, prefix=prefix)
+
     def _timed(self, key, fn, *args):
         """fn(*args), its wall time added to self.timings[key]."""
         start = time.perf_counter()

@@ -31,7 +31,6 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .. import compat
 from ..boundary import clamped
 from ..constitutive import eps, von_mises
-from ..damage import DamageStep, source
 from ..forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from ..solvers import LinearSolver
 from .base import ProblemData, TimeStepper
@@ -61,10 +60,7 @@ class DynamicKelvinVoigt(TimeStepper):
         # (3.49): damage obstacle step, explicit source
         self.damage = None
         if self.damage_active:
-            phi_old = source(eps(self.u_old), self.zeta_old, p)
-            self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.k),
-                                     fem.Constant(msh, float(p.kappa)), self.context,
-                                     obstacle=True, zeta_star=p.zeta_star, prefix=damage_prefix)
+            self.damage = self.obstacle_damage_step(damage_prefix)
 
         # (3.48): velocity, a constant matrix
         tags = data.geometry.facet_tags

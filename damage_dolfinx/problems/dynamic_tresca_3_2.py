@@ -29,7 +29,6 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
-from ..damage import DamageStep, source
 from ..forms.dynamic_tresca import total_stress, velocity_step_forms
 from ..friction import FrictionProblem, make_solver
 from ..parameters import InputError
@@ -56,10 +55,7 @@ class DynamicTresca(TimeStepper):
         self.error_components = [("u", self.u, "L2"), ("zeta", self.zeta, "L2")]  # (3.109)
 
         # (1) damage obstacle step (3.94), explicit source
-        phi_old = source(eps(self.u_old), self.zeta_old, p)
-        self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.k),
-                                 fem.Constant(msh, float(p.kappa)), self.context, obstacle=True,
-                                 zeta_star=p.zeta_star)
+        self.damage = self.obstacle_damage_step()
 
         # (2) velocity second-kind VI (3.95): inertia, viscosity and friction implicit
         tags = data.geometry.facet_tags

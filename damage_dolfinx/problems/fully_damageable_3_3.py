@@ -44,7 +44,6 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .. import compat
 from ..boundary import clamped
 from ..constitutive import eps, von_mises
-from ..damage import DamageStep, source
 from ..forms.fully_damageable import (implicit_velocity_residual, total_stress,
                                       velocity_step_forms)
 from ..parameters import InputError
@@ -77,10 +76,7 @@ class FullyDamageableContact(TimeStepper):
         # (3.158): damage obstacle step, source phi_A(eps(u_{n-1}), eta_*(zeta_{n-1}))
         self.damage = None
         if self.damage_active:
-            phi_old = source(eps(self.u_old), self.zeta_old, p)
-            self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.k),
-                                     fem.Constant(msh, float(p.kappa)), self.context,
-                                     obstacle=True, zeta_star=p.zeta_star, prefix=damage_prefix)
+            self.damage = self.obstacle_damage_step(damage_prefix)
 
         # (3.159): velocity with the new damage in the viscosity
         tags = data.geometry.facet_tags

@@ -27,7 +27,6 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
-from ..damage import DamageStep, source
 from ..forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
 from ..friction import FrictionProblem, make_solver
 from ..parameters import InputError
@@ -47,10 +46,7 @@ class KelvinVoigtTresca(TimeStepper):
         self.k = data.time.k
 
         # (1) damage obstacle step, explicit source
-        phi_old = source(eps(self.u_old), self.zeta_old, p)
-        self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.k),
-                                 fem.Constant(msh, float(p.kappa)), self.context, obstacle=True,
-                                 zeta_star=p.zeta_star)
+        self.damage = self.obstacle_damage_step()
 
         # (2) velocity second-kind VI with bilateral contact and Tresca friction
         tags = data.geometry.facet_tags

@@ -27,7 +27,6 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
-from ..damage import DamageStep, source
 from ..forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from ..friction import FrictionProblem, make_solver
 from ..parameters import InputError
@@ -80,10 +79,7 @@ class ElastoViscoplasticFriction(TimeStepper):
                                     x.get("friction_tol", 1e-6))
 
         # (4) damage obstacle step, source from step n-1 (G17: variant A, no sigma dependence)
-        phi_old = source(eps(self.u_old), self.zeta_old, p)
-        self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, k,
-                                 fem.Constant(msh, float(p.kappa)), self.context, obstacle=True,
-                                 zeta_star=p.zeta_star)
+        self.damage = self.obstacle_damage_step()
 
         self.von_mises = fem.Function(compat.scalar_dg0(msh), name="von_mises")
         self._vm_expr = compat.expression(von_mises(self.sigma), self.von_mises.function_space)
