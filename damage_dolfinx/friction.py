@@ -409,6 +409,22 @@ class RegularisedNewton:
         return its
 
 
+def solver_from_parameters(problem: FrictionProblem, extra: dict, facet_tags, gamma_D: int,
+                           example_id: str):
+    """The solver named by ``extra["friction_solver"]`` with its parameters from ``extra``
+    (eps_reg, rho_uzawa, omega_pd, friction_tol). Uzawa is refused without a clamped part
+    Gamma_D: its operator is then singular (quasistatic) or its ||eps(v)|| stopping test cannot
+    see rigid motions (dynamic)."""
+    kind = extra["friction_solver"]
+    comm = problem.msh.comm
+    if kind == "uzawa" and comm.allreduce(int(np.sum(facet_tags.values == gamma_D))) == 0:
+        raise InputError(f"{example_id}: the Uzawa friction solver needs a clamped part Gamma_D "
+                         "(without it its operator is singular or its ||eps(v)|| stopping test "
+                         "cannot see rigid motions); use newton or penalty-duality")
+    return make_solver(kind, problem, extra["eps_reg"], extra.get("rho_uzawa", 1.0),
+                       extra.get("omega_pd", 100.0), extra.get("friction_tol", 1e-6))
+
+
 def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: float,
                 omega_pd: float, tol: float = 1e-6):
     """The friction solver selected by ``kind`` (newton | uzawa | penalty-duality)."""

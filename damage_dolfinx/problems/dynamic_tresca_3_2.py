@@ -30,8 +30,7 @@ from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..forms.dynamic_tresca import total_stress, velocity_step_forms
-from ..friction import FrictionProblem, make_solver
-from ..parameters import InputError
+from ..friction import FrictionProblem, solver_from_parameters
 from ..stability import check_time_step, estimate_k_max
 from .base import ProblemData, TimeStepper
 
@@ -65,18 +64,12 @@ class DynamicTresca(TimeStepper):
                                    self.u_old, self.zeta_old, float(x["rho"]), self.k, p.E, p.nu,
                                    x["m_visc"], p.L_trunc, p.zeta_star, f_B, f_N, ds(GAMMA_N))
         self.bcs = [clamped(V, tags, GAMMA_D)] + normal_component_zero(V, tags, GAMMA_C)
-        has_gamma_D = self.comm.allreduce(int(np.sum(tags.values == GAMMA_D)), op=MPI.SUM) > 0
-        if x["friction_solver"] == "uzawa" and not has_gamma_D:
-            raise InputError(f"{data.example_id}: the Uzawa friction solver needs a clamped part "
-                             "Gamma_D (its ||eps(v)|| stopping test cannot see rigid "
-                             "translations); use newton or penalty-duality")
         g_builder = data.builders.get("friction_bound")
         g = g_builder(ufl.SpatialCoordinate(msh)) if g_builder else fem.Constant(msh, x["g_fric"])
         self.friction_problem = FrictionProblem(self.v, a, l, self.bcs, g, ds(GAMMA_C),
                                                 self.context)
-        self.friction = make_solver(x["friction_solver"], self.friction_problem, x["eps_reg"],
-                                    x.get("rho_uzawa", 1.0), x.get("omega_pd", 1.0),
-                                    x.get("friction_tol", 1e-6))
+        self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
+                                               data.example_id)
         self._faces_setup(data.builders.get("contact_faces") or {})
         self.k_max = self._stability_check(V, x)
 

@@ -28,8 +28,7 @@ from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
-from ..friction import FrictionProblem, make_solver
-from ..parameters import InputError
+from ..friction import FrictionProblem, solver_from_parameters
 from .base import ProblemData, TimeStepper
 
 
@@ -56,17 +55,11 @@ class KelvinVoigtTresca(TimeStepper):
         a, l = velocity_step_forms(ufl.TrialFunction(V), w, self.u_old, self.zeta_old, p.E, p.nu,
                                    x["m_visc"], p.L_trunc, f_B, f_N, ds(GAMMA_N))
         bcs = [clamped(V, tags, GAMMA_D)] + normal_component_zero(V, tags, GAMMA_C)
-        has_gamma_D = self.comm.allreduce(int(np.sum(tags.values == GAMMA_D)), op=MPI.SUM) > 0
-        if x["friction_solver"] == "uzawa" and not has_gamma_D:
-            raise InputError(f"{data.example_id}: the Uzawa friction solver needs a clamped part "
-                             "Gamma_D (its linear operator is singular otherwise); use newton or "
-                             "penalty-duality")
         g_builder = data.builders.get("friction_bound")
         g = g_builder(ufl.SpatialCoordinate(msh)) if g_builder else fem.Constant(msh, x["g_fric"])
         self.friction_problem = FrictionProblem(self.v, a, l, bcs, g, ds(GAMMA_C), self.context)
-        self.friction = make_solver(x["friction_solver"], self.friction_problem, x["eps_reg"],
-                                    x.get("rho_uzawa", 1.0), x.get("omega_pd", 1.0),
-                                    x.get("friction_tol", 1e-6))
+        self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
+                                               data.example_id)
         self._probe_setup(data.builders.get("probe"), ufl.action(a, self.v) - l)
 
         Q = compat.scalar_dg0(msh)

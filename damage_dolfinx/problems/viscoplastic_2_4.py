@@ -28,8 +28,7 @@ from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
-from ..friction import FrictionProblem, make_solver
-from ..parameters import InputError
+from ..friction import FrictionProblem, solver_from_parameters
 from .base import ProblemData, TimeStepper
 
 FRICTION_LAWS = ("tresca", "coulomb")
@@ -72,11 +71,9 @@ class ElastoViscoplasticFriction(TimeStepper):
         if law == "tresca" or x["coulomb_normal"] == "bilateral":
             bcs += normal_component_zero(V, tags, GAMMA_C)
         g = fem.Constant(msh, float(x["g_fric"] if law == "tresca" else x["mu_f"] * abs(x["S_n"])))
-        self._check_solver(x["friction_solver"], tags)
         self.friction_problem = FrictionProblem(self.w, a, l, bcs, g, ds(GAMMA_C), self.context)
-        self.friction = make_solver(x["friction_solver"], self.friction_problem, x["eps_reg"],
-                                    x.get("rho_uzawa", 1.0), x.get("omega_pd", 100.0),
-                                    x.get("friction_tol", 1e-6))
+        self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
+                                               data.example_id)
 
         # (4) damage obstacle step, source from step n-1 (G17: variant A, no sigma dependence)
         self.damage = self.obstacle_damage_step()
@@ -89,12 +86,6 @@ class ElastoViscoplasticFriction(TimeStepper):
         self.error_components = [("u", self.u, "V"), ("sigma", self.sigma, "L2"),
                                  ("zeta", self.zeta, "L2")]  # e_hk of Section 2.4.3
         self.timings = {"damage": 0.0, "friction": 0.0, "stress": 0.0}
-
-    def _check_solver(self, kind, tags):
-        has_gamma_D = self.comm.allreduce(int(np.sum(tags.values == GAMMA_D)), op=MPI.SUM) > 0
-        if kind == "uzawa" and not has_gamma_D:
-            raise InputError(f"{self.data.example_id}: the Uzawa friction solver needs a clamped "
-                             "part Gamma_D; use newton or penalty-duality")
 
     @staticmethod
     def _gamma_c_dofs(V, tags):
