@@ -10,8 +10,10 @@ where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet cond
   (2.99)-(2.101) with a backtracking line search on the convex energy
   1/2 a(v,v) - l(v) + j_eps(v) (SNES objective), warm start from the previous step at the target
   eps_reg (1e-9); fallbacks: an eps continuation (1e-2, 1e-3, ..., target), then the same
-  continuation with a Jacobian shift (needed when no Gamma_D holds the body). Linear solves: MUMPS LU,
-  re-factorised only when the Jacobian changes (i.e. when the stick set changes).
+  continuation with a Jacobian shift (needed when no Gamma_D holds the body). The residual is
+  algebraic (:class:`AlgebraicResidual`: one matrix-vector product per iteration, no assembly);
+  linear solves by Cholesky (PETSc's in serial, MUMPS in parallel), re-factorised only when the
+  Jacobian changes (i.e. when the stick set changes).
 * :class:`Uzawa` (2.98) with the corrections of G8: lambda_{s+1} = P(lambda_s + rho g v_tau),
   P(x) = x / max(1, |x|); the unregularised problem (needs Gamma_D: a must be coercive).
 * :class:`PenaltyDuality`: the Bermudez-Moreno iteration on the regularised problem, as in the
@@ -37,8 +39,8 @@ from . import compat
 from .constitutive import eps as strain
 from .contact import F_reg, NODAL_QUADRATURE, Phi_reg, tangent
 from .parameters import InputError
-from .solvers import (DIRECT, NEWTON, ConvergenceError, NonlinearSolver,
-                      SolveContext, set_default_options)
+from .solvers import (NEWTON, ConvergenceError, NonlinearSolver, SolveContext,
+                      set_default_options, spd_direct)
 
 #: relative Jacobian shift on contact nodes (units of g per unit slip velocity)
 JACOBIAN_SHIFT = 1e-3
@@ -104,8 +106,9 @@ class ContactNodes:
         self.tau = tau / np.linalg.norm(tau, axis=1)[:, None]
 
     def tangential(self, v):
-        """v_tau at the contact nodes (owned)."""
-        return np.einsum("ic,ic->i", v.x.array.reshape(-1, 2)[self.dofs], self.tau)
+        """v_tau at the contact nodes (owned); ``v`` a Function or a PETSc Vec."""
+        array = v.x.array if hasattr(v, "x") else v.getArray(readonly=True)
+        return np.einsum("ic,ic->i", array.reshape(-1, 2)[self.dofs], self.tau)
 
     def add_tangential_load(self, b: PETSc.Vec, force):
         """b_i -= m_i force_i tau_i on the owned contact nodes (the nodal integral of force w_tau)."""
@@ -128,8 +131,8 @@ def _assembled(L) -> np.ndarray:
 
 
 class ConstantOperator:
-    """A constant matrix assembled and factorised once (options prefix), solving for many
-    right-hand sides."""
+    """A constant symmetric matrix assembled and factorised once (Cholesky, options prefix),
+    solving for many right-hand sides."""
 
     def __init__(self, a, bcs, prefix, context):
         self.a = compat.form(a)
@@ -137,7 +140,7 @@ class ConstantOperator:
         compat.assemble_matrix(self.A, self.a, bcs)
         self.A.assemble()
         self.prefix, self.context = prefix, context
-        set_default_options(prefix, DIRECT)
+        set_default_options(prefix, spd_direct(self.A.getComm().tompi4py()))
         self.ksp = PETSc.KSP().create(self.A.getComm())
         self.ksp.setOptionsPrefix(prefix)
         self.ksp.setOperators(self.A)
@@ -266,6 +269,66 @@ FRICTION_NEWTON = {**NEWTON, "snes_linesearch_type": "bt", "snes_max_it": 100,
                    "snes_rtol": 1e-9, "snes_atol": 1e-10, "snes_stol": 1e-14}
 
 
+class AlgebraicResidual:
+    """The residual of the regularised problem (2.99) without form assembly:
+
+        F(v) = A v - b + sum_i m_i Phi_eps(v_tau,i) tau_i   (Dirichlet rows: v - v_D),
+
+    A the matrix of the constant form ``a`` (Dirichlet rows and columns eliminated, assembled
+    once), b the lifted right-hand side ``l`` (assembled once per time step by
+    :meth:`assemble_rhs`), the friction forces nodal (ContactNodes). One matrix-vector product
+    per Newton iteration instead of an assembly over all cells. It equals the assembled UFL
+    residual where Gamma_C is straight; :meth:`matches` checks that."""
+
+    def __init__(self, problem: FrictionProblem, nodes: ContactNodes, eps: fem.Constant):
+        self.p, self.nodes, self.eps = problem, nodes, eps
+        self.a, self.l = compat.form(problem.a), compat.form(problem.l)
+        self.A = compat.create_matrix(self.a)
+        compat.assemble_matrix(self.A, self.a, problem.bcs)
+        self.A.assemble()
+        self.b = compat.create_vector(self.l)
+        self._v = compat.petsc_vec(problem.v)
+
+    def assemble_rhs(self):
+        with self.b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(self.b, self.l)
+        compat.apply_lifting(self.b, self.a, self.p.bcs)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        compat.set_bc(self.b, self.p.bcs)
+
+    def __call__(self, x, r):
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        x.copy(self._v)  # the (UFL) Jacobian is assembled from v
+        self.p.v.x.scatter_forward()
+        self.A.mult(x, r)
+        r.axpy(-1.0, self.b)
+        phi = self.nodes.g * np.clip(self.nodes.tangential(x) / self.eps.value, -1.0, 1.0)
+        self.nodes.add_tangential_load(r, -phi)
+        compat.set_bc(r, self.p.bcs, x, -1.0)
+
+    def matches(self, form_residual, rtol=1e-10) -> bool:
+        """True if this residual equals the assembled one (``form_residual``) at two test
+        velocities, one slipping and one near the stick threshold, on every rank."""
+        saved = self.p.v.x.array.copy()
+        X = self.p.V.tabulate_dof_coordinates()[:, :2]
+        pattern = np.column_stack([np.sin(3.0 * X[:, 0] + 1.0) + np.cos(5.0 * X[:, 1]),
+                                   np.cos(2.0 * X[:, 0]) - np.sin(4.0 * X[:, 1] + 0.5)]).ravel()
+        self.assemble_rhs()
+        x, r1, r2 = self._v.copy(), self.b.duplicate(), self.b.duplicate()
+        worst = 0.0
+        for scale in (1.0, 2.0 * float(self.eps.value)):
+            with x.localForm() as xl:
+                xl.array[:] = scale * pattern
+            self(x, r1)
+            form_residual(x, r2)
+            r1.axpy(-1.0, r2)
+            worst = max(worst, r1.norm(PETSc.NormType.INFINITY)
+                        / max(r2.norm(PETSc.NormType.INFINITY), 1e-300))
+        self.p.v.x.array[:] = saved
+        return worst <= rtol
+
+
 class RegularisedNewton:
     """Newton on the regularised optimality equation (2.99)-(2.101):
     a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9)."""
@@ -303,10 +366,15 @@ class RegularisedNewton:
                   + (F_reg(v_tau, problem.g, self.eps)
                      - F_reg(ufl.dot(self.v0, tt), problem.g, self.eps)) * ds)
         self._energy = compat.form(energy)
+        self.residual = AlgebraicResidual(problem, self.nodes, self.eps)
         self.newton = NonlinearSolver(F, v, problem.bcs, prefix, problem.context,
-                                      defaults=FRICTION_NEWTON,
+                                      defaults={**FRICTION_NEWTON, **spd_direct(msh.comm)},
                                       refactor_after_its=REFACTOR_ITS, J=J,
-                                      jacobian_key=self._stick_set)
+                                      jacobian_key=self._stick_set, residual=self.residual)
+        # the assembled residual where the nodal one is not exact (a bent Gamma_C)
+        self.algebraic = True
+        if not self.residual.matches(self.newton.form_residual):
+            self.use_form_residual()
         newton_solve = self.newton.solve
 
         def solve_from_here():
@@ -321,6 +389,12 @@ class RegularisedNewton:
         self.fast_failures, self._fast_pause = 0, 0
         self.prefix = prefix
         self.timings = {"solve": 0.0}
+
+    def use_form_residual(self):
+        """Assemble the UFL residual in every Newton iteration (instead of AlgebraicResidual)."""
+        self.algebraic = False
+        self.newton.snes.snes.setFunction(lambda snes, x, f: self.newton.form_residual(x, f),
+                                          self.residual.b.duplicate())
 
     def _fast_attempt(self) -> bool:
         """Full Newton steps (basic line search: one residual per iteration, no energy) from
@@ -385,6 +459,8 @@ class RegularisedNewton:
         start = time.perf_counter()
         before = self.snes.iterations
         self.eps.value = self.target
+        if self.algebraic:
+            self.residual.assemble_rhs()
         try:
             if not self._fast_attempt():  # full steps; Newton with the energy line search:
                 self.newton.solve()

@@ -60,3 +60,50 @@ def test_stick_slip_example3(tmp_path):
     top, bottom = np.isclose(X[:, 1], 4.0), np.isclose(X[:, 1], 0.0)
     print(f"max |u1| top {np.abs(u[top, 0]).max():.3e}, bottom {np.abs(u[bottom, 0]).max():.3e}")
     assert np.abs(u[top, 0]).max() < 1e-6 * np.abs(u[bottom, 0]).max()
+
+
+def _friction_problem(contact_sides):
+    """A clamped-left unit square with Tresca friction (g = 3) on ``contact_sides``."""
+    import ufl
+    from dolfinx import fem, mesh
+    from mpi4py import MPI
+    from damage_dolfinx import compat
+    from damage_dolfinx.friction import FrictionProblem
+    from damage_dolfinx.solvers import SolveContext
+    msh = mesh.create_unit_square(MPI.COMM_WORLD, 6, 6)
+    msh.topology.create_connectivity(1, 2)
+    sides = {"left": lambda x: np.isclose(x[0], 0.0), "bottom": lambda x: np.isclose(x[1], 0.0),
+             "right": lambda x: np.isclose(x[0], 1.0)}
+    facets = {s: mesh.locate_entities_boundary(msh, 1, sides[s]) for s in ("left", *contact_sides)}
+    indices = np.concatenate([facets[s] for s in contact_sides])
+    order = np.argsort(indices)
+    tags = mesh.meshtags(msh, 1, indices[order], np.full(indices.size, 2, dtype=np.int32))
+    V = compat.vector_p1(msh)
+    u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+    e = lambda f: ufl.sym(ufl.grad(f))  # noqa: E731
+    a = ufl.inner(e(u), e(w)) * ufl.dx
+    l = ufl.dot(fem.Constant(msh, np.array([5.0, -1.0])), w) * ufl.dx
+    clamp = fem.dirichletbc(np.zeros(2), fem.locate_dofs_topological(V, 1, facets["left"]), V)
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+    return FrictionProblem(fem.Function(V), a, l, [clamp], fem.Constant(msh, 3.0), ds(2),
+                           SolveContext("unit"))
+
+
+def test_algebraic_friction_residual():
+    """The Newton residual A v - b + sum_i m_i Phi_eps(v_tau,i) tau_i (no assembly) equals the
+    assembled UFL residual on a straight Gamma_C, so both give the same velocity; on a bent
+    Gamma_C (a corner node) it does not, and the solver falls back to assembly."""
+    from damage_dolfinx.friction import RegularisedNewton
+    velocities = []
+    for force_assembly in (False, True):
+        newton = RegularisedNewton(_friction_problem(("bottom",)), eps_reg=1e-9)
+        assert newton.algebraic
+        if force_assembly:
+            newton.use_form_residual()
+        newton.solve()
+        velocities.append(newton.p.v.x.array.copy())
+    assert np.linalg.norm(velocities[0] - velocities[1]) <= 1e-9 * np.linalg.norm(velocities[1])
+    assert np.abs(velocities[1]).max() > 1e-3  # it moves (and slides)
+    bent = RegularisedNewton(_friction_problem(("bottom", "right")), eps_reg=1e-9)
+    assert not bent.algebraic
+    bent.solve()
