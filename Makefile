@@ -59,17 +59,17 @@ bench: setup
 
 # All convergence studies at thesis resolution, references on $(NP) ranks (make convergence NP=4).
 convergence: setup
-	$(PY) benchmarks/convergence_all.py --np $(NP) --out $(OUT)/convergence
+	$(PY) benchmarks/convergence_all.py --np $(NP) --out $(OUT)/convergence $(if $(RESUME),--resume)
 
 convergence-quick: setup
-	$(PY) benchmarks/convergence_all.py --quick --np $(NP) --out $(OUT)/convergence-quick
+	$(PY) benchmarks/convergence_all.py --quick --np $(NP) --out $(OUT)/convergence-quick $(if $(RESUME),--resume)
 
 # Every thesis figure with a computed result (PNG named after the figure number).
 figures: setup
-	$(PY) benchmarks/figures.py --np $(NP) --out $(OUT)/figures
+	$(PY) benchmarks/figures.py --np $(NP) --out $(OUT)/figures $(if $(RESUME),--resume)
 
 figures-quick: setup
-	$(PY) benchmarks/figures.py --quick --np $(NP) --out $(OUT)/figures-quick
+	$(PY) benchmarks/figures.py --quick --np $(NP) --out $(OUT)/figures-quick $(if $(RESUME),--resume)
 
 # results/REPORT.md and results/REPORT.html from the figures, tables and benchmark outputs.
 report: setup

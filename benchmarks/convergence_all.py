@@ -17,10 +17,12 @@ p.add_argument("--quick", action="store_true", help="three coarse meshes, small 
 p.add_argument("--np", type=int, default=2, help="MPI ranks")
 p.add_argument("--out", default=None)
 p.add_argument("--only", nargs="+", help="example ids")
+p.add_argument("--resume", action="store_true",
+               help="keep the runs that completed in an earlier invocation into the same OUT")
 a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/convergence-quick" if a.quick else "results/convergence"))
-index = reproduce.run_convergence(mode, out, a.np, a.only)
+index = reproduce.run_convergence(mode, out, a.np, a.only, a.resume)
 for s in index["studies"]:
     rate = s.get("rates", {}).get("h_plus_k_all")
     print(f"{s['example']} {s['variant']}: exit {s['returncode']}, {s['wall_time_s']} s, "

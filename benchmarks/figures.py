@@ -17,10 +17,12 @@ p.add_argument("--quick", action="store_true", help="coarse meshes (minutes)")
 p.add_argument("--np", type=int, default=2, help="MPI ranks per run")
 p.add_argument("--out", default=None)
 p.add_argument("--only", nargs="+", help="example ids")
+p.add_argument("--resume", action="store_true",
+               help="keep the runs that completed in an earlier invocation into the same OUT")
 a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/figures-quick" if a.quick else "results/figures"))
-index = reproduce.run_figures(mode, out, a.np, a.only)
+index = reproduce.run_figures(mode, out, a.np, a.only, a.resume)
 failed = [r for r in index["runs"] if r["returncode"] != 0]
 print(f"{len(index['figures'])} figures from {len(index['runs'])} runs in {index['wall_time_s']} s "
       f"({mode} mode, {a.np} ranks) -> {out}; failed runs: {[r['example'] for r in failed] or 'none'}")

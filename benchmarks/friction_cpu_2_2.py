@@ -3,6 +3,7 @@ friction solvers side by side, n in {16, 32, 64, 128} x k in {0.02, 0.01, 0.005,
 
     .venv/bin/python benchmarks/friction_cpu_2_2.py [--n 16 32 64 128] [--k 0.02 ...]
                                                     [--budget 600] [--out results/bench/friction_cpu]
+                                                    [--set g_fric=200 rho_uzawa=1e-3]
 
 Each (solver, n, k) cell is one full run (T = 1) with the thesis stopping test (relative
 V-change 1e-6 for Uzawa and penalty-duality, eps_reg = 1e-9 for Newton and penalty-duality).
@@ -30,7 +31,10 @@ parser.add_argument("--n", type=int, nargs="+", default=[16, 32, 64, 128])
 parser.add_argument("--k", type=float, nargs="+", default=[0.02, 0.01, 0.005, 0.002])
 parser.add_argument("--budget", type=float, default=600.0)
 parser.add_argument("--out", default="results/bench/friction_cpu")
+parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
+                    help="parameter overrides for every run, e.g. g_fric=200 rho_uzawa=1e-3")
 args = parser.parse_args()
+extra = dict(item.split("=", 1) for item in args.set)
 comm = MPI.COMM_WORLD
 out = Path(args.out)
 
@@ -56,7 +60,7 @@ def v_distance(a, b, msh_ref):
 def floor_time(n, k):
     """Damage steps + one factorised linear solve per time step (the cost floor)."""
     ex = examples.get("2.2-ex1")
-    s = ex.build(comm, n=n, k=k, overrides={"friction_solver": "uzawa"})
+    s = ex.build(comm, n=n, k=k, overrides={**extra, "friction_solver": "uzawa"})
     s.initialize()
     fr = s.friction
     start = time.perf_counter()
@@ -80,7 +84,7 @@ for n in args.n:
                 continue
             try:
                 s = runner.run("2.2-ex1", folder, n=n, k=k,
-                               overrides={"friction_solver": solver}, progress=False,
+                               overrides={**extra, "friction_solver": solver}, progress=False,
                                figures=False, write_every=10**9, time_limit=args.budget)
                 done = s["status"] == "completed"
                 row[f"{solver}_iterations"] = s["iterations"]["friction"]
@@ -102,7 +106,8 @@ for n in args.n:
 if comm.rank == 0:
     out.mkdir(parents=True, exist_ok=True)
     (out / "cpu.json").write_text(json.dumps({"rows": rows, "budget_s": args.budget,
-                                              "mpi_size": comm.size}, indent=2))
+                                              "overrides": extra, "mpi_size": comm.size},
+                                             indent=2))
     fmt = lambda v: "-" if v is None else f"{v:.1f}"  # noqa: E731
     lines = ["| n | k | Newton s | Uzawa s | penalty-duality s | floor s | Newton/floor | "
              "Uzawa/Newton | PD/Newton | Uzawa-Newton (V) | PD-Newton (V) |", "|---" * 11 + "|"]

@@ -9,6 +9,10 @@ the report (report.py) is built from it. A failed run is recorded and the others
 
 Quick mode: coarse meshes (n / 4, 2h) at the thesis time steps, minutes in total. Full mode: the
 catalogue defaults, i.e. the thesis resolutions (or the documented G-defaults).
+
+Resume (``--resume``, ``make figures RESUME=1``): an interrupted reproduction is started again
+into the same folder; runs and studies that completed are kept, an interrupted figure run goes on
+from its last checkpoint. ``wall_time_s`` in index.json is then the sum over all invocations.
 """
 from __future__ import annotations
 
@@ -134,20 +138,50 @@ def _display(command: list, np_: int) -> str:
     return (f"mpirun -n {np_} " if np_ > 1 else "") + "damage-dolfinx " + " ".join(command)
 
 
-def run_figures(mode: str, out: Path, np_: int = 2, only=None) -> dict:
-    """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``."""
+def _previous_entries(out: Path, key: str, mode: str) -> dict:
+    """Successful entries of an earlier ``out/index.json`` (same mode), by job name."""
+    try:
+        old = json.loads((out / "index.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    if old.get("mode") != mode:
+        return {}
+    return {e["example"] + (f"-{e['variant']}" if e["variant"] else ""): e
+            for e in old.get(key, []) if e.get("returncode") == 0}
+
+
+def _finish(index: dict, key: str, start: float):
+    """Total wall time: this invocation, and the sum over all runs (resumed ones included)."""
+    index["wall_time_this_invocation_s"] = round(time.perf_counter() - start, 1)
+    index["wall_time_s"] = round(sum(e["wall_time_s"] for e in index[key]), 1)
+
+
+def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False) -> dict:
+    """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``. With
+    ``resume``, jobs that completed in an earlier invocation (same mode) are kept, not rerun."""
     out.mkdir(parents=True, exist_ok=True)
     runs = out / "runs"
+    done = _previous_entries(out, "runs", mode) if resume else {}
+    old_figures = json.loads((out / "index.json").read_text())["figures"] if done else []
     index = {"mode": mode, "mpi_size": np_, "runs": [], "figures": []}
     start = time.perf_counter()
     for job in figure_jobs(mode):
         if only and job.example not in only:
             continue
+        if job.name in done:
+            index["runs"].append(done[job.name])
+            index["figures"] += [f for f in old_figures if f["example"] == job.example
+                                 and f["variant"] == job.variant]
+            print(f"[figures] {job.name}: done earlier ({done[job.name]['wall_time_s']} s)")
+            continue
         run_dir = runs / job.name
-        if run_dir.exists():
+        # an interrupted run of an earlier invocation goes on from its last checkpoint
+        restart = resume and (run_dir / "checkpoint.json").is_file()
+        if run_dir.exists() and not restart:
             shutil.rmtree(run_dir)
-        run_dir.mkdir(parents=True)
-        command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir)]
+        run_dir.mkdir(parents=True, exist_ok=True)
+        command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir),
+                   *(["--restart"] if restart else [])]
         ranks = 1 if job.example in SERIAL else np_
         code, wall, _ = _launch(command, ranks, run_dir / "log.txt")
         entry = {"example": job.example, "variant": job.variant, "command": _display(command, ranks),
@@ -167,9 +201,12 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None) -> dict:
         index["runs"].append(entry)
         print(f"[figures] {job.name}: exit {code}, {wall:.1f} s", flush=True)
         (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
-    if not only or "2.1-ex3" in only:
+    if (not only or "2.1-ex3" in only) and "2.1-ex3-force-displacement" not in done:
         _bridge_force_displacement(mode, out, np_, index)
-    index["wall_time_s"] = round(time.perf_counter() - start, 1)
+    elif "2.1-ex3-force-displacement" in done:
+        index["runs"].append(done["2.1-ex3-force-displacement"])
+        index["figures"] += [f for f in old_figures if f["file"] == "figure_2_7.png"]
+    _finish(index, "runs", start)
     (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
     return index
 
@@ -202,13 +239,19 @@ def _bridge_force_displacement(mode, out, np_, index):
                                  "command": command})
 
 
-def run_convergence(mode: str, out: Path, np_: int = 2, only=None) -> dict:
-    """Run every convergence study into ``out/<id>[-variant]`` and write ``out/index.json``."""
+def run_convergence(mode: str, out: Path, np_: int = 2, only=None, resume=False) -> dict:
+    """Run every convergence study into ``out/<id>[-variant]`` and write ``out/index.json``.
+    With ``resume``, studies that completed in an earlier invocation (same mode) are kept."""
     out.mkdir(parents=True, exist_ok=True)
+    done = _previous_entries(out, "studies", mode) if resume else {}
     index = {"mode": mode, "mpi_size": np_, "studies": []}
     start = time.perf_counter()
     for job in convergence_jobs(mode):
         if only and job.example not in only:
+            continue
+        if job.name in done:
+            index["studies"].append(done[job.name])
+            print(f"[convergence] {job.name}: done earlier ({done[job.name]['wall_time_s']} s)")
             continue
         folder = out / job.name
         folder.mkdir(parents=True, exist_ok=True)
@@ -228,6 +271,6 @@ def run_convergence(mode: str, out: Path, np_: int = 2, only=None) -> dict:
         index["studies"].append(entry)
         print(f"[convergence] {job.name}: exit {code}, {wall:.1f} s", flush=True)
         (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
-    index["wall_time_s"] = round(time.perf_counter() - start, 1)
+    _finish(index, "studies", start)
     (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
     return index

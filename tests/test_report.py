@@ -1,5 +1,6 @@
 """`make figures` / `make report` machinery: a quick figure run of one example, the report built
 from it, and the HTML opened in headless Chromium with every image loading."""
+import json
 import re
 import shutil
 import subprocess
@@ -38,3 +39,26 @@ def test_quick_figures_and_report(tmp_path):
     broken.write_text(page.read_text().replace("<body>", '<body><img src="missing.png">', 1))
     loaded, total = _images_in_chromium(broken)
     assert loaded == total - 1
+
+
+def test_resumed_reproduction_keeps_completed_runs(tmp_path):
+    """`make figures RESUME=1`: a completed run is kept (not rerun), a missing one is run, an
+    interrupted one goes on from its checkpoint (--restart)."""
+    out = tmp_path / "figures"
+    first = reproduce.run_figures("quick", out, np_=1, only=["2.1-ex1"])
+    log = out / "runs" / "2.1-ex1" / "log.txt"
+    stamp = log.stat().st_mtime_ns
+    second = reproduce.run_figures("quick", out, np_=1, only=["2.1-ex1", "2.3-ex1"], resume=True)
+    assert log.stat().st_mtime_ns == stamp                      # not rerun
+    assert second["runs"][0] == first["runs"][0]
+    assert [r["example"] for r in second["runs"]] == ["2.1-ex1", "2.3-ex1"]
+    assert {"figure_2_14.png"} <= {f["file"] for f in second["figures"]}
+    assert second["wall_time_s"] == round(sum(r["wall_time_s"] for r in second["runs"]), 1)
+    # an interrupted 2.3-ex1: drop its index entry, leave a checkpoint -> restarted, not wiped
+    index = json.loads((out / "index.json").read_text())
+    index["runs"] = [r for r in index["runs"] if r["example"] != "2.3-ex1"]
+    (out / "index.json").write_text(json.dumps(index))
+    (out / "runs" / "2.3-ex1" / "checkpoint.json").write_text("{}")  # not a valid checkpoint
+    third = reproduce.run_figures("quick", out, np_=1, only=["2.3-ex1"], resume=True)
+    assert "--restart" in third["runs"][0]["command"] and third["runs"][0]["returncode"] != 0
+    assert "checkpoint" in (out / "runs" / "2.3-ex1" / "log.txt").read_text()
