@@ -3,7 +3,7 @@ friction solvers side by side, n in {16, 32, 64, 128} x k in {0.02, 0.01, 0.005,
 
     .venv/bin/python benchmarks/friction_cpu_2_2.py [--n 16 32 64 128] [--k 0.02 ...]
                                                     [--budget 600] [--out results/bench/friction_cpu]
-                                                    [--set g_fric=200 rho_uzawa=1e-3]
+                                                    [--set g_fric=200 rho_uzawa=1e-3] [--render]
 
 Each (solver, n, k) cell is one full run (T = 1) with the thesis stopping test (relative
 V-change 1e-6 for Uzawa and penalty-duality, eps_reg = 1e-9 for Newton and penalty-duality).
@@ -33,6 +33,8 @@ parser.add_argument("--budget", type=float, default=600.0)
 parser.add_argument("--out", default="results/bench/friction_cpu")
 parser.add_argument("--set", nargs="*", default=[], metavar="KEY=VALUE",
                     help="parameter overrides for every run, e.g. g_fric=200 rho_uzawa=1e-3")
+parser.add_argument("--render", action="store_true",
+                    help="only rewrite cpu.md from OUT/cpu.json and the run folders")
 args = parser.parse_args()
 extra = dict(item.split("=", 1) for item in args.set)
 comm = MPI.COMM_WORLD
@@ -73,6 +75,51 @@ def floor_time(n, k):
     return time.perf_counter() - start
 
 
+def friction_seconds(row):
+    """The friction-step time of each completed run (timings_s of its summary.json)."""
+    for solver in SOLVERS:
+        summary = out / f"{solver}_n{row['n']}_k{row['k']}" / "summary.json"
+        if row.get(solver) is not None and summary.is_file():
+            row[f"{solver}_friction_s"] = json.loads(summary.read_text())["timings_s"]["friction"]
+
+
+def write_tables(rows):
+    """cpu.json and cpu.md: whole-run wall times (the damage steps, common to all three solvers,
+    included) and the friction-step times alone, with the ratios to Newton."""
+    out.mkdir(parents=True, exist_ok=True)
+    for row in rows:
+        friction_seconds(row)
+    (out / "cpu.json").write_text(json.dumps({"rows": rows, "budget_s": args.budget,
+                                              "overrides": extra, "mpi_size": comm.size},
+                                             indent=2))
+    fmt = lambda v: "-" if v is None else f"{v:.1f}"  # noqa: E731
+    lines = ["| n | k | Newton s | Uzawa s | penalty-duality s | floor s | Newton/floor | "
+             "Uzawa/Newton | PD/Newton | friction step s: Newton / Uzawa / PD | "
+             "Uzawa/Newton (friction) | PD/Newton (friction) | Uzawa-Newton (V) | "
+             "PD-Newton (V) |", "|---" * 14 + "|"]
+    for r in rows:
+        def ratio(a, b):
+            return "-" if r.get(a) is None or r.get(b) is None else f"{r[a] / r[b]:.1f}"
+        steps = " / ".join("-" if r.get(f"{solver}_friction_s") is None
+                           else f"{r[f'{solver}_friction_s']:.2f}" for solver in SOLVERS)
+        lines.append(f"| {r['n']} | {r['k']} | {fmt(r['newton'])} | {fmt(r['uzawa'])} | "
+                     f"{fmt(r['penalty-duality'])} | {r['floor_s']:.1f} | "
+                     f"{ratio('newton', 'floor_s')} | {ratio('uzawa', 'newton')} | "
+                     f"{ratio('penalty-duality', 'newton')} | {steps} | "
+                     f"{ratio('uzawa_friction_s', 'newton_friction_s')} | "
+                     f"{ratio('penalty-duality_friction_s', 'newton_friction_s')} | "
+                     f"{r.get('uzawa_vs_newton_V', float('nan')):.1e} | "
+                     f"{r.get('penalty-duality_vs_newton_V', float('nan')):.1e} |")
+    (out / "cpu.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+if args.render:  # tables only, from an earlier run's cpu.json and run folders
+    if comm.rank == 0:
+        write_tables(json.loads((out / "cpu.json").read_text())["rows"])
+    raise SystemExit
+
+
 rows, skipped = [], {solver: False for solver in SOLVERS}
 for n in args.n:
     for k in args.k:
@@ -104,20 +151,4 @@ for n in args.n:
             print(json.dumps(row), flush=True)
 
 if comm.rank == 0:
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "cpu.json").write_text(json.dumps({"rows": rows, "budget_s": args.budget,
-                                              "overrides": extra, "mpi_size": comm.size},
-                                             indent=2))
-    fmt = lambda v: "-" if v is None else f"{v:.1f}"  # noqa: E731
-    lines = ["| n | k | Newton s | Uzawa s | penalty-duality s | floor s | Newton/floor | "
-             "Uzawa/Newton | PD/Newton | Uzawa-Newton (V) | PD-Newton (V) |", "|---" * 11 + "|"]
-    for r in rows:
-        ratio = lambda a, b: "-" if r[a] is None or r[b] is None else f"{r[a] / r[b]:.1f}"  # noqa
-        lines.append(f"| {r['n']} | {r['k']} | {fmt(r['newton'])} | {fmt(r['uzawa'])} | "
-                     f"{fmt(r['penalty-duality'])} | {r['floor_s']:.1f} | "
-                     f"{ratio('newton', 'floor_s')} | {ratio('uzawa', 'newton')} | "
-                     f"{ratio('penalty-duality', 'newton')} | "
-                     f"{r.get('uzawa_vs_newton_V', float('nan')):.1e} | "
-                     f"{r.get('penalty-duality_vs_newton_V', float('nan')):.1e} |")
-    (out / "cpu.md").write_text("\n".join(lines) + "\n")
-    print("\n".join(lines))
+    write_tables(rows)
