@@ -187,6 +187,7 @@ class _IterativeFrictionSolver:
         with self.b0.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(self.b0, self.l)
+        compat.apply_lifting(self.b0, self.op.a, self.p.bcs)  # non-zero Dirichlet values
         self.b0.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         x = compat.petsc_vec(self.p.v)
         previous = x.copy()

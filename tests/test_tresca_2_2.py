@@ -107,3 +107,63 @@ def test_algebraic_friction_residual():
     bent = RegularisedNewton(_friction_problem(("bottom", "right")), eps_reg=1e-9)
     assert not bent.algebraic
     bent.solve()
+
+
+def _shear_block(mu, lam, g, side_shear, top_shear=None, top_velocity=None):
+    """Block (0,2)x(0,1), viscous operator 2 mu eps : eps + lam div div, bilateral contact with
+    Tresca friction (bound g) on the bottom, shear tractions (0, +-side_shear) on the sides and
+    either a shear traction (top_shear, 0) or a velocity (top_velocity, 0) on the top."""
+    import ufl
+    from dolfinx import fem, mesh
+    from mpi4py import MPI
+    from damage_dolfinx.friction import FrictionProblem
+    from damage_dolfinx.solvers import SolveContext
+    msh = mesh.create_rectangle(MPI.COMM_WORLD, [np.zeros(2), np.array([2.0, 1.0])], [8, 4])
+    msh.topology.create_connectivity(1, 2)
+    where = {1: lambda x: np.isclose(x[1], 0.0), 2: lambda x: np.isclose(x[1], 1.0),
+             3: lambda x: np.isclose(x[0], 0.0), 4: lambda x: np.isclose(x[0], 2.0)}
+    facets = {t: mesh.locate_entities_boundary(msh, 1, f) for t, f in where.items()}
+    indices = np.concatenate(list(facets.values()))
+    values = np.concatenate([np.full(f.size, t, dtype=np.int32) for t, f in facets.items()])
+    indices, first = np.unique(indices, return_index=True)
+    tags = mesh.meshtags(msh, 1, indices, values[first])
+    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+    e = lambda f: ufl.sym(ufl.grad(f))  # noqa: E731
+    a = 2 * mu * ufl.inner(e(u), e(w)) * ufl.dx + lam * ufl.div(u) * ufl.div(w) * ufl.dx
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+    l = side_shear * (w[1] * ds(4) - w[1] * ds(3))
+    bottom_v2 = fem.locate_dofs_topological(V.sub(1), 1, facets[1])
+    bcs = [fem.dirichletbc(0.0, bottom_v2, V.sub(1))]
+    if top_velocity is None:
+        l = l + top_shear * w[0] * ds(2)
+    else:
+        top = fem.locate_dofs_topological(V, 1, facets[2])
+        bcs.append(fem.dirichletbc(np.array([top_velocity, 0.0]), top, V))
+    return FrictionProblem(fem.Function(V), a, l, bcs, fem.Constant(msh, g), ds(1),
+                           SolveContext("shear block"))
+
+
+def test_friction_solvers_reproduce_simple_shear():
+    """Closed-form simple shear v = (v_b + sigma_12 y / mu, 0) (P1 represents it exactly).
+    Stick: shear stress s = 1 < g = 3, the regularised law gives v_b = eps s / g. Slip: top
+    velocity 2.5 > g H / mu = 1.5, the bottom slides at v_b = 2.5 - 1.5 = 1 under the friction
+    stress g (the friction force equals g times the contact length). Newton for both; Uzawa and
+    penalty-duality for the slip case."""
+    from damage_dolfinx.friction import make_solver
+    mu, lam, g, eps = 2.0, 1.0, 3.0, 1e-9
+    cases = [("stick", dict(side_shear=1.0, top_shear=1.0), eps * 1.0 / g, 1.0, ["newton"]),
+             ("slip", dict(side_shear=g, top_velocity=2.5), 1.0, g,
+              ["newton", "uzawa", "penalty-duality"])]
+    for name, load, v_b, shear, solvers in cases:
+        for kind in solvers:
+            problem = _shear_block(mu, lam, g, **load)
+            make_solver(kind, problem, eps_reg=eps, rho_uzawa=0.1, omega_pd=10.0,
+                        tol=1e-12).solve()
+            X = problem.V.tabulate_dof_coordinates()[:, :2]
+            v = problem.v.x.array.reshape(-1, 2)
+            exact = v_b + shear * X[:, 1] / mu
+            tol = 1e-8 if kind == "newton" else 1e-6  # Uzawa, PD: iterative, stopped at 1e-12
+            assert np.abs(v[:, 0] - exact).max() <= tol * max(np.abs(exact).max(), 1e-300) \
+                + 1e-14, (name, kind, np.abs(v[:, 0] - exact).max())
+            assert np.abs(v[:, 1]).max() <= 1e-10, (name, kind)
