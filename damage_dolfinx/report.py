@@ -5,7 +5,8 @@ Sources, each traceable to the command that produced it:
 * convergence tables: ``<results>/convergence/<study>/`` if present, else the committed outputs
   in ``benchmarks/reference_output/convergence/<study>/``;
 * bridge failure load: the figure run of 2.1-ex3 or ``reference_output/bridge``;
-* friction CPU comparison: ``reference_output/friction_cpu/cpu.md`` (benchmarks/friction_cpu_2_2.py);
+* friction CPU comparison: ``reference_output/friction_cpu/cpu.md`` and ``friction_cpu_stick/cpu.md``
+  (benchmarks/friction_cpu_2_2.py);
 * assumptions: the catalogue (every example's list, with the PROBLEMS.md gap numbers).
 The HTML is produced from the same blocks (no Markdown library needed).
 """
@@ -283,3 +284,10 @@ def _friction_cpu(doc):
                  "`python benchmarks/friction_cpu_2_2.py`, committed output "
                  "`benchmarks/reference_output/friction_cpu/cpu.md`):")
         doc.markdown_table(table.read_text())
+    stick = REFERENCE / "friction_cpu_stick" / "cpu.md"
+    if stick.is_file():
+        doc.para("The same with stick-slip (friction bound g = 200 instead of 5, Uzawa step "
+                 "rho = 1e-3 from the G8 sweep at n = 16; `python benchmarks/friction_cpu_2_2.py "
+                 "--set g_fric=200 rho_uzawa=1e-3`, output "
+                 "`benchmarks/reference_output/friction_cpu_stick/cpu.md`):")
+        doc.markdown_table(stick.read_text())
