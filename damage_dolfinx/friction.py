@@ -308,6 +308,27 @@ class AlgebraicResidual:
         self.nodes.add_tangential_load(r, -phi)
         compat.set_bc(r, self.p.bcs, x, -1.0)
 
+    def energy_change(self, x, x0) -> float:
+        """E(x) - E(x0) of the convex energy 1/2 a(v,v) - l(v) + j_eps(v) whose gradient is this
+        residual: 1/2 (x + x0)^T A (x - x0) - b^T (x - x0) + sum_i m_i (F_eps(x_tau,i) -
+        F_eps(x0_tau,i)) (2.101), without cancellation against the large |E|."""
+        d, s = x.copy(), x.copy()
+        d.axpy(-1.0, x0)
+        s.axpy(1.0, x0)
+        Ad = d.duplicate()
+        self.A.mult(d, Ad)
+        quadratic = 0.5 * s.dot(Ad) - self.b.dot(d)
+        for v in (d, s, Ad):
+            v.destroy()
+        eps, g, m = float(self.eps.value), self.nodes.g, self.nodes.m
+
+        def potential(r):
+            a = np.abs(r)
+            return g * np.where(a <= eps, r * r / (2.0 * eps), a - eps / 2.0)
+        local = float(np.sum(m * (potential(self.nodes.tangential(x))
+                                  - potential(self.nodes.tangential(x0)))))
+        return quadratic + self.p.msh.comm.allreduce(local)
+
     def matches(self, form_residual, rtol=1e-10) -> bool:
         """True if this residual equals the assembled one (``form_residual``) at two test
         velocities, one slipping and one near the stick threshold, on every rank."""
@@ -448,6 +469,9 @@ class RegularisedNewton:
             self.shift.value = 0.0
 
     def _objective(self, snes, x):
+        """E(x) - E(v0) (the line search's merit function): algebraic when the residual is."""
+        if self.algebraic:
+            return self.residual.energy_change(x, compat.petsc_vec(self.v0))
         x.copy(compat.petsc_vec(self.p.v))
         self.p.v.x.scatter_forward()
         return compat.assemble_scalar(self._energy, self.p.msh.comm)

@@ -103,6 +103,18 @@ def test_algebraic_friction_residual():
         newton.solve()
         velocities.append(newton.p.v.x.array.copy())
     assert np.linalg.norm(velocities[0] - velocities[1]) <= 1e-9 * np.linalg.norm(velocities[1])
+    # the algebraic line-search energy E(x) - E(v0) equals the assembled one (on V)
+    from damage_dolfinx import compat
+    x = compat.petsc_vec(newton.p.v).copy()
+    newton.v0.x.array[:] = 0.5 * newton.p.v.x.array
+    for scale in (1.0, 1e-9):  # slip and near the stick threshold
+        x.array[:] = scale * np.sin(np.arange(x.array.size))
+        compat.set_bc(x, newton.p.bcs)  # Newton iterates satisfy the Dirichlet conditions
+        newton.algebraic = True
+        algebraic = newton._objective(None, x)
+        newton.algebraic = False
+        assembled = newton._objective(None, x)
+        assert abs(algebraic - assembled) <= 1e-10 * abs(assembled), (scale, algebraic, assembled)
     assert np.abs(velocities[1]).max() > 1e-3  # it moves (and slides)
     bent = RegularisedNewton(_friction_problem(("bottom", "right")), eps_reg=1e-9)
     assert not bent.algebraic
