@@ -58,7 +58,7 @@ def main():
     a = p.parse_args()
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
-    rows = []
+    rows = _kept_rows(out / "performance.json", a.only)
     for example, (sizes, ref) in SIZES.items():
         if a.only and example not in a.only:
             continue
@@ -69,6 +69,20 @@ def main():
                 rows.append(row)
                 print(json.dumps(row), flush=True)
                 (out / "performance.json").write_text(json.dumps(rows, indent=1))
+    write_tables(rows, out)
+
+
+def _kept_rows(path: Path, only) -> list:
+    """With --only, the rows of the other examples from an earlier performance.json in the same
+    folder are kept, so that a partial rerun updates the record instead of replacing it."""
+    if not only or not path.exists():
+        return []
+    return [r for r in json.loads(path.read_text()) if r["example"] not in only]
+
+
+def write_tables(rows: list, out: Path):
+    """performance.md (serial vs 2 ranks per size) and performance.csv from the measured rows."""
+    rows = sorted(rows, key=lambda r: list(SIZES).index(r["example"]))
     lines = ["| example | n | dofs (u) | serial [ms/step] | 2 ranks [ms/step] | speed-up |",
              "|---|---|---|---|---|---|"]
     for example in dict.fromkeys(r["example"] for r in rows):
