@@ -213,10 +213,38 @@ def build(results: Path) -> Path:
                 _friction_cpu(doc)
             doc.para("**Assumptions** (PROBLEMS.md gap numbers):")
             doc.items(ex.assumptions)
+    _wall_times(doc, fig_index, conv_index)
+    _performance(doc, results)
     md, page = results / "REPORT.md", results / "REPORT.html"
     md.write_text(doc.to_markdown())
     page.write_text(doc.to_html("damage-dolfinx report"))
     return page
+
+
+def _wall_times(doc, fig_index, conv_index):
+    """Wall time of every run of this reproduction (figure runs and convergence studies)."""
+    rows = [(f"figures: {r['example']} {r['variant']}".rstrip(), r.get("status") or f"exit {r['returncode']}",
+             r["wall_time_s"]) for r in (fig_index or {}).get("runs", [])]
+    rows += [(f"convergence: {s['example']} {s['variant']}".rstrip(), s.get("status") or f"exit {s['returncode']}",
+              s["wall_time_s"]) for s in conv_index.get("studies", [])]
+    if not rows:
+        return
+    doc.heading(2, "Wall times of this reproduction")
+    total = sum(t for _, _, t in rows)
+    doc.markdown_table("| run | status | wall time [s] |\n|---|---|---|\n"
+                       + "".join(f"| {name} | {status} | {t:.1f} |\n" for name, status, t in rows)
+                       + f"| **total** | | **{total:.0f}** ({total / 3600:.2f} h) |\n")
+
+
+def _performance(doc, results):
+    """Time per step vs dofs, serial and 2 ranks (benchmarks/performance.py)."""
+    for table in (results / "performance" / "performance.md", REFERENCE / "performance" / "performance.md"):
+        if table.is_file():
+            doc.heading(2, "Performance: time per step vs dofs, serial and 2 MPI ranks")
+            doc.para(f"`python benchmarks/performance.py`, from `{_shown(table)}`; the speed-up is "
+                     "serial over 2-rank time per step, `(ref)` marks the convergence reference size.")
+            doc.markdown_table(table.read_text())
+            return
 
 
 def _figures_of(doc, example_id, fig_dir, fig_index):
