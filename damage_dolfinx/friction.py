@@ -289,6 +289,7 @@ class AlgebraicResidual:
         self.A.assemble()
         self.b = compat.create_vector(self.l)
         self._v = compat.petsc_vec(problem.v)
+        self._work = [self.b.duplicate() for _ in range(3)]  # energy_change: d, s, A d
 
     def assemble_rhs(self):
         with self.b.localForm() as bl:
@@ -312,14 +313,13 @@ class AlgebraicResidual:
         """E(x) - E(x0) of the convex energy 1/2 a(v,v) - l(v) + j_eps(v) whose gradient is this
         residual: 1/2 (x + x0)^T A (x - x0) - b^T (x - x0) + sum_i m_i (F_eps(x_tau,i) -
         F_eps(x0_tau,i)) (2.101), without cancellation against the large |E|."""
-        d, s = x.copy(), x.copy()
+        d, s, Ad = self._work
+        x.copy(d)
         d.axpy(-1.0, x0)
+        x.copy(s)
         s.axpy(1.0, x0)
-        Ad = d.duplicate()
         self.A.mult(d, Ad)
         quadratic = 0.5 * s.dot(Ad) - self.b.dot(d)
-        for v in (d, s, Ad):
-            v.destroy()
         eps, g, m = float(self.eps.value), self.nodes.g, self.nodes.m
 
         def potential(r):
