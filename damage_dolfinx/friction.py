@@ -9,7 +9,9 @@ where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet cond
 * :class:`RegularisedNewton` (the main solver): SNES Newton on the regularised law Phi_eps
   (2.99)-(2.101) with a backtracking line search on the convex energy
   1/2 a(v,v) - l(v) + j_eps(v) (SNES objective), warm start from the previous step at the target
-  eps_reg (1e-9); fallbacks: an eps continuation (1e-2, 1e-3, ..., target), then the same
+  eps_reg (1e-9). Each step first tries full Newton steps, then the primal-dual active-set
+  iteration on the same equations (:class:`PrimalDualActiveSet`, for steps that reverse the
+  slip), then the line search; further fallbacks: an eps continuation (1e-2, 1e-3, ..., target), then the same
   continuation with a Jacobian shift (needed when no Gamma_D holds the body). The residual is
   algebraic (:class:`AlgebraicResidual`: one matrix-vector product per iteration, no assembly);
   linear solves by Cholesky (PETSc's in serial, MUMPS in parallel), re-factorised only when the
@@ -33,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 import ufl
 from dolfinx import fem
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
@@ -53,6 +56,8 @@ SOLVERS = ("newton", "uzawa", "penalty-duality")
 FAST_MAX_IT = 6
 #: after a failed first attempt, go straight to the energy line search for this many steps
 FAST_PAUSE_STEPS = 10
+#: iterations of the primal-dual active-set attempt before the line-search Newton takes over
+PDAS_MAX_IT = 50
 
 
 @dataclass
@@ -351,6 +356,97 @@ class AlgebraicResidual:
         return worst <= rtol
 
 
+class PrimalDualActiveSet:
+    """Primal-dual active-set (semismooth) Newton for the same regularised problem (2.99)-(2.101)
+    (Stadler, SIAM J. Optim. 15, 2004), with the nodal multipliers lambda_i = Phi_eps(v_tau,i)/g_i
+    as a second unknown:
+
+        A v - b + sum_i m_i g_i lambda_i tau_i = 0,   max(1, |v_tau,i|/eps) lambda_i = v_tau,i/eps.
+
+    Linearised at (v, lambda) and condensed (lambda eliminated node by node), each iteration is one
+    Cholesky solve with A + sum_i K_i tau_i tau_i^T: K_i = m_i g_i/eps on the nodes with
+    |v_tau| <= eps, K_i = m_i g_i (1 - lambda_i sgn v_tau,i)/|v_tau,i| on the others (0 once
+    lambda_i is consistent, large while it points against the slip). A slip reversal is thus
+    damped by the multiplier, where the primal Newton (K_i = 0 on slipping nodes) overshoots and
+    its line search needs 10-100 iterations per step (2.2-ex1 at k = 0.02, benchmarks/README.md).
+    The stopping test is the primal Newton's: ||F(v)|| of :class:`AlgebraicResidual`.
+    Needs axis-parallel tangents (tau tau^T diagonal), like the bilateral contact conditions."""
+
+    def __init__(self, residual: "AlgebraicResidual", prefix: str):
+        self.residual, self.nodes, self.p = residual, residual.nodes, residual.p
+        tau = self.nodes.tau
+        comm = self.p.msh.comm
+        self.usable = comm.allreduce(bool(np.all(np.abs(tau[:, 0] * tau[:, 1]) < 1e-12)),
+                                     op=MPI.LAND)
+        self.rows = 2 * self.nodes.dofs + np.argmax(np.abs(tau), axis=1)  # owned tangential dofs
+        free = residual.b.duplicate()  # 0 on Dirichlet dofs (ghosted, as set_bc expects)
+        with free.localForm() as fl:
+            fl.set(1.0)
+        compat.set_bc(free, self.p.bcs, scale=0.0)
+        self.free_rows = free.array[self.rows] != 0.0
+        free.destroy()
+        self.J = residual.A.duplicate(copy=True)
+        self.d = self.J.createVecLeft()
+        self._last_d = None
+        set_default_options(prefix, spd_direct(comm))
+        self.ksp = PETSc.KSP().create(comm)
+        self.ksp.setOptionsPrefix(prefix)
+        self.ksp.setFromOptions()
+
+    def _factorise(self, K):
+        """J = A + diag(K on the tangential dofs), refactorised only when K changed."""
+        self.d.set(0.0)
+        d = self.d.array
+        d[self.rows] = np.where(self.free_rows, K, 0.0)
+        comm = self.p.msh.comm
+        if self._last_d is not None and comm.allreduce(bool(np.array_equal(d, self._last_d)),
+                                                       op=MPI.LAND):
+            return
+        self.residual.A.copy(self.J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self.J.setDiagonal(self.d, addv=PETSc.InsertMode.ADD_VALUES)
+        self.ksp.setOperators(self.J)
+        self._last_d = d.copy()
+
+    def solve(self, x: PETSc.Vec, eps: float, rtol: float, atol: float, max_it: int) -> int:
+        """Iterate from x (the previous velocity; lambda consistent with it) until ||F(x)|| <=
+        max(rtol ||F(x0)||, atol); returns the iterations, raises ConvergenceError otherwise."""
+        nodes, g, gm = self.nodes, self.nodes.g, self.nodes.g * self.nodes.m
+        r, rhs = x.duplicate(), x.duplicate()
+        self.residual(x, r)
+        r0 = r.norm()
+        s = nodes.tangential(x)
+        lam = np.clip(s / eps, -1.0, 1.0)
+        shift = 0.0
+        for it in range(1, max_it + 1):
+            active = np.abs(s) > eps
+            sign, size = np.sign(s), np.maximum(np.abs(s), eps)
+            K = np.where(active, gm * (1.0 - lam * sign) / size, gm / eps)
+            while True:
+                # with ``shift``, a proximal term shift g m (s_new - s) on the sliding nodes
+                # (zero at convergence) keeps the matrix regular when no Gamma_D holds the body
+                # and every node slides with a consistent multiplier (K = 0)
+                self._factorise(K + np.where(active, shift * gm, 0.0))
+                self.residual.b.copy(rhs)
+                nodes.add_tangential_load(rhs, np.where(active, g * (lam - shift * s), 0.0))
+                compat.set_bc(rhs, self.p.bcs)
+                self.ksp.solve(rhs, x)
+                if self.ksp.getConvergedReason() > 0:
+                    break
+                if shift > 0.0:
+                    raise ConvergenceError(f"primal-dual active set: linear solve failed "
+                                           f"(reason {self.ksp.getConvergedReason()})")
+                shift = JACOBIAN_SHIFT
+            s_new = nodes.tangential(x)
+            lam = np.clip(np.where(active, sign + (1.0 - lam * sign) * (s_new - s) / size,
+                                   s_new / eps), -1.0, 1.0)
+            s = s_new
+            self.residual(x, r)
+            if r.norm() <= max(rtol * r0, atol):
+                return it
+        raise ConvergenceError(f"primal-dual active set: ||F|| = {r.norm():.3e} after {max_it} "
+                               f"iterations (start {r0:.3e})")
+
+
 class RegularisedNewton:
     """Newton on the regularised optimality equation (2.99)-(2.101):
     a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9)."""
@@ -397,6 +493,9 @@ class RegularisedNewton:
         self.algebraic = True
         if not self.residual.matches(self.newton.form_residual):
             self.use_form_residual()
+        pdas = PrimalDualActiveSet(self.residual, prefix + "pdas_") if self.algebraic else None
+        self.pdas = pdas if pdas is not None and pdas.usable else None
+        self.pdas_iterations = self.pdas_solves = self.pdas_failures = 0
         newton_solve = self.newton.solve
 
         def solve_from_here():
@@ -438,6 +537,26 @@ class RegularisedNewton:
             self._fast_pause = FAST_PAUSE_STEPS
             return False
 
+    def _pdas_attempt(self) -> bool:
+        """The primal-dual active-set iteration from the previous velocity (PrimalDualActiveSet),
+        to the SNES tolerances; False if unavailable or failed (v is then unchanged)."""
+        if self.pdas is None:
+            return False
+        x = compat.petsc_vec(self.p.v)
+        saved = x.copy()
+        rtol, atol, _, _ = self.snes.snes.getTolerances()
+        try:
+            self.pdas_iterations += self.pdas.solve(x, self.target, rtol, atol, PDAS_MAX_IT)
+            self.pdas_solves += 1
+            return True
+        except ConvergenceError:
+            saved.copy(x)
+            self.pdas_failures += 1
+            return False
+        finally:
+            saved.destroy()
+            self.p.v.x.scatter_forward()
+
     def _with_line_search(self, kind, fn):
         opts, key = PETSc.Options(), self.prefix + "snes_linesearch_type"
         previous = opts.getString(key, "bt")
@@ -477,17 +596,18 @@ class RegularisedNewton:
         return compat.assemble_scalar(self._energy, self.p.msh.comm)
 
     def solve(self) -> int:
-        """Newton at the target eps from the previous velocity (backtracking on the energy); on
-        failure an eps continuation 1e-2, 1e-3, ... -> target with warm starts; on failure again the same
+        """Full Newton steps at the target eps from the previous velocity, else the primal-dual
+        active-set iteration, else Newton with backtracking on the energy; on failure an eps continuation 1e-2, 1e-3, ... -> target with warm starts; on failure again the same
         continuation with the Jacobian shift on its non-final stages; last, full Newton steps.
         Returns this step's Newton iterations."""
         start = time.perf_counter()
-        before = self.snes.iterations
+        before = self.snes.iterations + self.pdas_iterations
         self.eps.value = self.target
         if self.algebraic:
             self.residual.assemble_rhs()
         try:
-            if not self._fast_attempt():  # full steps; Newton with the energy line search:
+            # full Newton steps; then the primal-dual active set; then the energy line search
+            if not self._fast_attempt() and not self._pdas_attempt():
                 self.newton.solve()
         except ConvergenceError:
             self.continuations += 1  # v is unchanged: restart with eps continuation
@@ -503,11 +623,18 @@ class RegularisedNewton:
                     # near convergence at large |energy| stalls it)
                     self.full_step_solves += 1
                     self._with_line_search("basic", self.newton.solve)
-        its = self.snes.iterations - before
+        its = self.snes.iterations + self.pdas_iterations - before
         self.iterations += its
         self.solves += 1
         self.timings["solve"] += time.perf_counter() - start
         return its
+
+
+def iteration_counters(solver) -> dict:
+    """The friction solver's fallback counters for summary.json (zeros for Uzawa and PD)."""
+    return {f"friction_{name}": getattr(solver, name, 0)
+            for name in ("continuations", "shifted_continuations", "full_step_solves",
+                         "pdas_solves", "pdas_iterations", "pdas_failures")}
 
 
 def solver_from_parameters(problem: FrictionProblem, extra: dict, facet_tags, gamma_D: int,

@@ -30,7 +30,7 @@ from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..forms.dynamic_tresca import total_stress, velocity_step_forms
-from ..friction import FrictionProblem, solver_from_parameters
+from ..friction import FrictionProblem, iteration_counters, solver_from_parameters
 from ..stability import check_time_step, estimate_k_max
 from .base import ProblemData, TimeStepper
 
@@ -137,10 +137,7 @@ class DynamicTresca(TimeStepper):
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations, "friction": self.friction.iterations,
-                "friction_solver": self.friction.name,
-                "friction_continuations": getattr(self.friction, "continuations", 0),
-                "friction_shifted_continuations": getattr(self.friction, "shifted_continuations", 0),
-                "friction_full_step_solves": getattr(self.friction, "full_step_solves", 0)}
+                "friction_solver": self.friction.name, **iteration_counters(self.friction)}
 
     def summary_extra(self) -> dict:
         return {} if self.k_max is None else {"k_max": self.k_max}

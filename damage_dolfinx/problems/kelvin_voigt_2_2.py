@@ -28,7 +28,7 @@ from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
-from ..friction import FrictionProblem, solver_from_parameters
+from ..friction import FrictionProblem, iteration_counters, solver_from_parameters
 from .base import ProblemData, TimeStepper
 
 
@@ -128,7 +128,4 @@ class KelvinVoigtTresca(TimeStepper):
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations, "friction": self.friction.iterations,
-                "friction_solver": self.friction.name,
-                "friction_continuations": getattr(self.friction, "continuations", 0),
-                "friction_shifted_continuations": getattr(self.friction, "shifted_continuations", 0),
-                "friction_full_step_solves": getattr(self.friction, "full_step_solves", 0)}
+                "friction_solver": self.friction.name, **iteration_counters(self.friction)}

@@ -28,7 +28,7 @@ from .. import compat
 from ..boundary import clamped, normal_component_zero
 from ..constitutive import eps, von_mises
 from ..forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
-from ..friction import FrictionProblem, solver_from_parameters
+from ..friction import FrictionProblem, iteration_counters, solver_from_parameters
 from .base import ProblemData, TimeStepper
 
 FRICTION_LAWS = ("tresca", "coulomb")
@@ -141,6 +141,4 @@ class ElastoViscoplasticFriction(TimeStepper):
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations, "friction": self.friction.iterations,
-                "friction_solver": self.friction.name,
-                "friction_continuations": getattr(self.friction, "continuations", 0),
-                "friction_shifted_continuations": getattr(self.friction, "shifted_continuations", 0)}
+                "friction_solver": self.friction.name, **iteration_counters(self.friction)}
