@@ -32,8 +32,10 @@ def examples():
     common = [
         "G6: kappa = 1e-2 (missing in the thesis)",
         "A = 1e-2 B (m_visc = 100), L_trunc = 1000, variant A, q_star = 1000",
-        "G9: friction solved by Newton on Phi_eps with eps_reg = 1e-9 (warm start; eps "
-        "continuation 1e-2, 1e-3, ..., 1e-8 only when the direct solve fails); Uzawa and "
+        "G9: friction solved by Newton on Phi_eps with eps_reg = 1e-9 (warm start: full "
+        "Newton steps, then a primal-dual active-set iteration on the same equations "
+        "(Stadler 2004) for steps that reverse the slip, then an energy line search; eps "
+        "continuation 1e-2, 1e-3, ..., 1e-8 only when these fail); Uzawa and "
         "penalty-duality available for comparison (--set friction_solver=...)",
         "friction functional integrated by the vertex (trapezoidal) rule: a nodal Tresca law, "
         "identical for the three solvers",
