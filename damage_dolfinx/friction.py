@@ -57,6 +57,7 @@ FAST_MAX_IT = 6
 #: after a failed first attempt, go straight to the energy line search for this many steps
 FAST_PAUSE_STEPS = 10
 #: iterations of the primal-dual active-set attempt before the line-search Newton takes over
+#: (PETSc option -<prefix>pdas_max_it, e.g. -friction_pdas_max_it 0 to skip the attempt)
 PDAS_MAX_IT = 50
 
 
@@ -387,6 +388,7 @@ class PrimalDualActiveSet:
         free.destroy()
         self.J = residual.A.duplicate(copy=True)
         self.d = self.J.createVecLeft()
+        self._r, self._rhs = residual.b.duplicate(), residual.b.duplicate()
         self._last_d = None
         set_default_options(prefix, spd_direct(comm))
         self.ksp = PETSc.KSP().create(comm)
@@ -411,7 +413,7 @@ class PrimalDualActiveSet:
         """Iterate from x (the previous velocity; lambda consistent with it) until ||F(x)|| <=
         max(rtol ||F(x0)||, atol); returns the iterations, raises ConvergenceError otherwise."""
         nodes, g, gm = self.nodes, self.nodes.g, self.nodes.g * self.nodes.m
-        r, rhs = x.duplicate(), x.duplicate()
+        r, rhs = self._r, self._rhs
         self.residual(x, r)
         r0 = r.norm()
         s = nodes.tangential(x)
@@ -540,13 +542,14 @@ class RegularisedNewton:
     def _pdas_attempt(self) -> bool:
         """The primal-dual active-set iteration from the previous velocity (PrimalDualActiveSet),
         to the SNES tolerances; False if unavailable or failed (v is then unchanged)."""
-        if self.pdas is None:
+        max_it = PETSc.Options().getInt(self.prefix + "pdas_max_it", PDAS_MAX_IT)
+        if self.pdas is None or max_it <= 0:
             return False
         x = compat.petsc_vec(self.p.v)
         saved = x.copy()
         rtol, atol, _, _ = self.snes.snes.getTolerances()
         try:
-            self.pdas_iterations += self.pdas.solve(x, self.target, rtol, atol, PDAS_MAX_IT)
+            self.pdas_iterations += self.pdas.solve(x, self.target, rtol, atol, max_it)
             self.pdas_solves += 1
             return True
         except ConvergenceError:
