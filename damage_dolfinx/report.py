@@ -221,12 +221,17 @@ def build(results: Path) -> Path:
     return page
 
 
+def _status(entry) -> str:
+    """A run's status in index.json ("completed", ...) or its exit code."""
+    return entry.get("status") or f"exit {entry['returncode']}"
+
+
 def _wall_times(doc, fig_index, conv_index):
     """Wall time of every run of this reproduction (figure runs and convergence studies)."""
-    rows = [(f"figures: {r['example']} {r['variant']}".rstrip(), r.get("status") or f"exit {r['returncode']}",
-             r["wall_time_s"]) for r in (fig_index or {}).get("runs", [])]
-    rows += [(f"convergence: {s['example']} {s['variant']}".rstrip(), s.get("status") or f"exit {s['returncode']}",
-              s["wall_time_s"]) for s in conv_index.get("studies", [])]
+    groups = (("figures", (fig_index or {}).get("runs", [])),
+              ("convergence", conv_index.get("studies", [])))
+    rows = [(f"{kind}: {e['example']} {e['variant']}".rstrip(), _status(e), e["wall_time_s"])
+            for kind, entries in groups for e in entries]
     if not rows:
         return
     doc.heading(2, "Wall times of this reproduction")
@@ -252,7 +257,7 @@ def _figures_of(doc, example_id, fig_dir, fig_index):
         return
     for run in fig_index["runs"]:
         if run["example"] == example_id:
-            status = run.get("status") or f"exit {run['returncode']}"
+            status = _status(run)
             doc.para(f"Run{' (' + run['variant'] + ')' if run['variant'] else ''}: `{run['command']}`"
                      f" ({status}, {run['wall_time_s']} s)")
     for fig in fig_index["figures"]:
