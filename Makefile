@@ -16,7 +16,10 @@ export MPLBACKEND := Agg
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix \
     python3-ffcx python3-gmsh gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
     python3-venv python3-setuptools gcc chromium
+# As root (containers, CI runners) apt-get runs directly; otherwise through sudo. `env` carries
+# DEBIAN_FRONTEND through sudo and works without it (an empty $(SUDO) must not leave a bare flag).
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+APT := $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get
 
 .PHONY: setup system-deps demo test bench convergence convergence-quick figures figures-quick \
     report clean
@@ -30,8 +33,7 @@ system-deps:
 	  echo "setup: Debian FEniCSx stack present"; \
 	else \
 	  echo "setup: installing the Debian FEniCSx stack (apt-get)"; \
-	  $(SUDO) apt-get update && \
-	  DEBIAN_FRONTEND=noninteractive $(SUDO) -E apt-get install -y $(APT_PACKAGES); \
+	  $(APT) update && $(APT) install -y $(APT_PACKAGES); \
 	fi
 
 $(VENV)/.installed: pyproject.toml | system-deps
