@@ -96,7 +96,7 @@ class NestedTransferDG0:
 
 def nested_transfer(V_coarse, V_fine, grid):
     """The exact nested transfer for P1 (:class:`NestedTransfer`) or DG0 fields."""
-    degree = V_coarse.ufl_element().degree()
+    degree = compat.element_degree(V_coarse)
     return NestedTransferDG0(V_coarse, V_fine, grid) if degree == 0 else \
         NestedTransfer(V_coarse, V_fine, grid)
 
@@ -136,50 +136,46 @@ def gather_cells(u_disp, field, amplification: float = 0.0):
     return np.concatenate(xy_all), np.concatenate(val_all)
 
 
-def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None, mesh_lines=False):
-    """One PNG with a panel per (Function, label) in ``fields``, on the configuration
-    x + amplification * u (PROBLEMS.md 1.9), with the deformed mesh edges if ``mesh_lines``
-    (the thesis's "deformed mesh" figures); collective, rank 0 draws."""
-    gathered = [(gather_cells(u_disp, f, amplification), label) for f, label in fields]
-    # optional colour range of a field: attribute ``plot_range = (vmin, vmax)`` on the Function
-    ranges = [getattr(f, "plot_range", None) or (None, None) for f, _ in fields]
+def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None, mesh_lines=False,
+                zeta_star=None):
+    """One PNG of ``fields`` ((Function, label) pairs) on the configuration x + amplification * u
+    (PROBLEMS.md 1.9), drawn by figstyle (damage on [zeta*, 1], round factor in the title).
+    ``mesh_lines``: a thesis "deformed mesh" figure -- the mesh edges on the deformed body over
+    the undeformed outline, no colour field. The panel data are saved next to the PNG
+    (``.npz``) so that thesis pairs can be re-rendered on a shared scale. Collective."""
+    from . import figstyle
+    amplification = figstyle.drawn_amplification(amplification)  # e.g. the automatic G40 one
+    if zeta_star is None:
+        zeta_star = _run_zeta_star(path)
+    gathered = [gather_cells(u_disp, f, amplification) for f, _ in fields]
     ref = gather_cells(None, fields[0][0], 0.0) if outline else None
-    if MPI.COMM_WORLD.rank != 0 or gathered[0][0] is None:
+    if MPI.COMM_WORLD.rank != 0 or gathered[0] is None:
         return
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.tri as mtri
+    panels = [{"xy": g[0], "values": g[1], "name": getattr(f, "name", ""), "label": label}
+              for g, (f, label) in zip(gathered, fields)]
+    meta = dict(title=title, amplification=amplification, zeta_star=zeta_star,
+                mesh_only=bool(mesh_lines))
+    figstyle.render_fields(panels, path, ref_xy=ref[0] if ref else None, **meta)
+    figstyle.save_panels(path, panels, ref_xy=ref[0] if ref else None, **meta)
 
-    fig, axes = plt.subplots(1, len(gathered), figsize=(5.6 * len(gathered), 4.8), squeeze=False)
-    for ax, ((xy, vals), label), (vmin, vmax) in zip(axes[0], gathered, ranges):
-        pts = xy.reshape(-1, 2)
-        tri = mtri.Triangulation(pts[:, 0], pts[:, 1], np.arange(pts.shape[0]).reshape(-1, 3))
-        if vals.ndim == 2:
-            im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap="viridis",
-                              vmin=vmin, vmax=vmax)
-        else:
-            im = ax.tripcolor(tri, facecolors=vals, cmap="viridis", vmin=vmin, vmax=vmax)
-        if mesh_lines:
-            ax.triplot(tri, color="k", lw=0.15, alpha=0.6)
-        if ref is not None:
-            _draw_outline(ax, ref[0])
-        ax.set_aspect("equal")
-        ax.set_title(label)
-        ax.set_xlabel("x1 [m]")
-        ax.set_ylabel("x2 [m]")
-        fig.colorbar(im, ax=ax, shrink=0.85)
-    suffix = f"  (displacements x{amplification:g})" if amplification not in (0, 1) else ""
-    import textwrap
-    lines = textwrap.wrap(title + suffix, width=50 * len(gathered))  # no clipping on 1 panel
-    fig.suptitle("\n".join(lines), fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 1 - 0.045 * len(lines)))
-    fig.savefig(path, dpi=130, bbox_inches="tight")
-    plt.close(fig)
+
+def _run_zeta_star(png_path):
+    """zeta_star of the run that draws ``png_path``: its summary.json (written by the runner
+    at step 0) lies in the same folder; None if there is none."""
+    import json
+    from pathlib import Path
+    try:
+        summary = json.loads((Path(png_path).parent / "summary.json").read_text())
+        return float(summary["parameters"]["zeta_star"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
 
 
 def plot_mesh(geometry, path, title="", labels=None):
-    """The mesh with its tagged boundary parts coloured (thesis 'setting' figures); collective."""
+    """The undeformed mesh with its tagged boundary parts (thesis 'setting' figures): Gamma_D
+    with clamp hatching, Gamma_C with the foundation drawn under it, the legend below the axes;
+    collective."""
+    from . import figstyle
     msh, tags = geometry.mesh, geometry.facet_tags
     xy = msh.comm.gather(compat.cell_vertex_coords(msh), root=0)
     parts = {}
@@ -188,39 +184,49 @@ def plot_mesh(geometry, path, title="", labels=None):
         parts[tag] = msh.comm.gather(local, root=0)
     if msh.comm.rank != 0:
         return
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection, PolyCollection
-    fig, ax = plt.subplots(figsize=(5.6, 5.2))
-    ax.add_collection(PolyCollection(np.concatenate(xy), facecolors="none", edgecolors="0.55",
-                                     linewidths=0.5))
-    for (tag, label), color in zip((labels or {}).items(), ("tab:red", "tab:blue", "tab:green")):
+    cells = np.concatenate(xy)
+    fig, (ax,) = figstyle.new_figure(1, figstyle.data_aspect(cells), panel_width=5.0)
+    ax.add_collection(PolyCollection(cells, facecolors="none", edgecolors="0.6",
+                                     linewidths=0.3 if len(cells) > 3000 else 0.5))
+    size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
+    styles = ("tab:red", "tab:blue", "tab:green")
+    for (tag, label), color in zip((labels or {}).items(), styles):
         segs = np.concatenate(parts[tag])
         if segs.size == 0:
             continue
-        ax.add_collection(LineCollection(segs, colors=color, linewidths=2.2, label=label))
-    ax.autoscale()
-    ax.set_aspect("equal")
-    ax.set_xlabel("x1 [m]")
-    ax.set_ylabel("x2 [m]")
-    ax.set_title(title)
-    if labels:
-        ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+        ax.add_collection(LineCollection(segs, colors=color, linewidths=2.2,
+                                         label=figstyle.mathtext(label), zorder=3))
+        if "clamp" in label or "contact" in label:  # hatch ticks outside the body
+            ax.add_collection(LineCollection(_hatch(segs, cells, size), colors=color,
+                                             linewidths=0.8, zorder=3))
+    figstyle._frame(ax, [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)])
+    figstyle.legend_below(ax)
+    figstyle.save(fig, path, title=figstyle.mathtext(title))
+
+
+def _hatch(segs, cells, size):
+    """Short oblique ticks on the outer side of boundary segments (support / foundation
+    symbol), about one per ``size`` of boundary length."""
+    import matplotlib.tri as mtri
+    length = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
+    keep = np.diff(np.floor(np.concatenate([[0.0], np.cumsum(length)]) / (1.5 * size))) > 0
+    segs, length = segs[keep], length[keep][:, None]
+    mid = segs.mean(1)
+    tangent = (segs[:, 1] - segs[:, 0]) / np.where(length > 0, length, 1)
+    normal = np.stack([tangent[:, 1], -tangent[:, 0]], 1)
+    pts, inverse = np.unique(np.round(cells.reshape(-1, 2), 10), axis=0, return_inverse=True)
+    tri = mtri.Triangulation(pts[:, 0], pts[:, 1], inverse.reshape(-1, 3))
+    probe = mid + 0.2 * size * normal  # inside the body -> flip to the outside
+    inside = tri.get_trifinder()(probe[:, 0], probe[:, 1]) >= 0
+    normal[inside] *= -1
+    return np.stack([mid, mid + size * (normal - 0.6 * tangent)], 1)
 
 
 def _draw_outline(ax, xy):
-    """Boundary edges (edges belonging to one triangle only) of the undeformed mesh."""
-    edges = np.concatenate([xy[:, [0, 1]], xy[:, [1, 2]], xy[:, [2, 0]]])
-    a, b = np.round(edges[:, 0], 9), np.round(edges[:, 1], 9)
-    swap = ((a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1])))[:, None]
-    key = np.hstack([np.where(swap, b, a), np.where(swap, a, b)])
-    _, idx, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
-    for e in edges[idx[counts == 1]]:
-        ax.plot(e[:, 0], e[:, 1], color="0.4", lw=0.6, ls="--")
+    """Boundary edges of the undeformed mesh (kept for benchmarks/lshape_3_1.py)."""
+    from . import figstyle
+    figstyle.draw_outline(ax, xy)
 
 
 def loglog_rate(x, y):
@@ -235,23 +241,21 @@ def loglog_rate(x, y):
 def plot_history(csv_path, columns, path, title=""):
     """Time histories of history.csv columns, one axis each (rank 0 only)."""
     import csv
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from . import figstyle
+    pyplot = figstyle.plt()
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
     t = np.array([float(r["t"]) for r in rows])
-    fig, axes = plt.subplots(len(columns), 1, figsize=(6.4, 2.6 * len(columns)), sharex=True,
-                             squeeze=False)
+    fig, axes = pyplot.subplots(len(columns), 1, figsize=(6.0, 2.2 * len(columns) + 0.6),
+                                sharex=True, squeeze=False)
     for ax, (column, label) in zip(axes[:, 0], columns):
         ax.plot(t, [float(r[column]) if r[column] else np.nan for r in rows], lw=1.2)
-        ax.set_ylabel(label)
+        ax.set_ylabel(figstyle.mathtext(label))
         ax.grid(True, alpha=0.3)
-    axes[-1, 0].set_xlabel("t [s]")
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+        if "zeta" in column:
+            ax.set_ylim(0, 1.05)
+    axes[-1, 0].set_xlabel("$t$ [s]")
+    figstyle.save(fig, path, title=figstyle.mathtext(title))
 
 
 def plot_damage_profiles(prof, history_csv, zeta_star, path, title, probe_column="zeta_probe",
@@ -260,33 +264,30 @@ def plot_damage_profiles(prof, history_csv, zeta_star, path, title, probe_column
     {"x1", "x2", "times", "zeta", "last_t", "last_zeta"}) and the probe history from
     history.csv with the zeta_star line (rank 0 only)."""
     import csv
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from . import figstyle
+    pyplot = figstyle.plt()
     with open(history_csv) as f:
         rows = list(csv.DictReader(f))
     t = [float(r["t"]) for r in rows]
     z = [float(r[probe_column]) for r in rows]
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
-    cmap = plt.get_cmap("viridis")
+    fig, (left, right) = pyplot.subplots(1, 2, figsize=(10, 3.8))
+    cmap = pyplot.get_cmap("viridis")
     curves = list(zip(prof["times"], prof["zeta"])) + [(prof["last_t"], prof["last_zeta"])]
     for i, (ti, zi) in enumerate(curves):
         last = i == len(curves) - 1
         left.plot(prof["x1"], zi, ls="--" if last else "-", lw=1.2,
                   color="k" if last else cmap(i / max(1, len(curves) - 1)),
                   label=f"t = {ti:.3g}" + (" (last)" if last else ""))
-    left.set_xlabel("x1 [m]")
-    left.set_ylabel(f"zeta on x2 = {prof['x2']:g}")
+    left.set_xlabel("$x_1$ [m]")
+    left.set_ylabel(f"$\\zeta$ on $x_2$ = {prof['x2']:g}   (1 = sound)")
     left.set_ylim(0, 1.05)
     left.grid(True, alpha=0.3)
     left.legend(fontsize=7, ncol=2)
     right.plot(t, z, lw=1.0)
-    right.axhline(zeta_star, color="r", lw=0.8, ls=":", label="zeta_star")
-    right.set_xlabel("t [s]")
-    right.set_ylabel(probe_label)
+    right.axhline(zeta_star, color="r", lw=0.8, ls=":", label=f"$\\zeta^*$ = {zeta_star:g}")
+    right.set_xlabel("$t$ [s]")
+    right.set_ylabel(figstyle.mathtext(probe_label))
+    right.set_ylim(0, 1.05)
     right.grid(True, alpha=0.3)
     right.legend(fontsize=8)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130, bbox_inches="tight")
-    plt.close(fig)
+    figstyle.save(fig, path, title=figstyle.mathtext(title))

@@ -25,6 +25,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import figstyle
+
 #: variants of an example that the thesis draws separately: suffix -> parameter overrides
 VARIANTS = {
     "2.4-ex1": {"tresca": {"friction_law": "tresca"}, "coulomb": {"friction_law": "coulomb"}},
@@ -125,8 +127,19 @@ def _launch(command: list, np_: int, log: Path) -> tuple:
     return code, time.perf_counter() - start, argv
 
 
+#: one file per thesis figure where the variants of one example are different thesis figures
+VARIANT_FIGURES = {
+    ("2.4-ex1", "tresca", "figure_2_24_25.png"): "figure_2_24.png",
+    ("2.4-ex1", "coulomb", "figure_2_24_25.png"): "figure_2_25.png",
+    ("3.3-ex2", "a", "figure_3_17_18.png"): "figure_3_17.png",
+    ("3.3-ex2", "b", "figure_3_17_18.png"): "figure_3_18.png",
+}
+
+
 def _figure_name(file: str, job: Job) -> str:
     """Thesis figures keep their number (plus the variant); other PNGs get the example id."""
+    if (job.example, job.variant, file) in VARIANT_FIGURES:
+        return VARIANT_FIGURES[(job.example, job.variant, file)]
     stem = Path(file).stem
     if not stem.startswith("figure_"):
         stem = f"{job.example}_{stem}"
@@ -194,10 +207,14 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False) -> 
             for fig in s["outputs"]["figures"]:
                 target = _figure_name(fig["file"], job)
                 shutil.copy(run_dir / fig["file"], out / target)
-                index["figures"].append({"file": target, "example": job.example,
+                index["figures"].append({"file": target, "source": fig["file"],
+                                         "example": job.example,
                                          "variant": job.variant, "title": s.get("title"),
                                          "command": entry["command"], **{
                                              k: fig[k] for k in ("t", "amplification") if k in fig}})
+                if "amplification" in fig:  # the factor the figure is drawn with (post.py)
+                    index["figures"][-1]["amplification"] = figstyle.drawn_amplification(
+                        fig["amplification"])
         index["runs"].append(entry)
         print(f"[figures] {job.name}: exit {code}, {wall:.1f} s", flush=True)
         (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")

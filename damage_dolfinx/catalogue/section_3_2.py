@@ -87,9 +87,11 @@ def examples():
             "at t = 0.4); Uzawa is refused: although the mass "
             "term makes a coercive, the ||eps(.)|| stopping test of friction.py does not see "
             "rigid translations (measured: stops after one iteration at n = 4, never at n = 20)"],
-        figures=[Figure("figure_3_11.png", "Example 3.2-2: deformed mesh", fields=("zeta",),
+        figures=[Figure("figure_3_10.png", "Example 3.2-2: setting and mesh", kind="mesh"),
+                 Figure("figure_3_11.png", "Example 3.2-2: deformed mesh", fields=("zeta",),
                         amplification=5.0, mesh_lines=True),
-                 Figure("figure_3_12.png", "Example 3.2-2: von Mises stress and damage"),
+                 Figure("figure_3_12.png", "Example 3.2-2: von Mises stress and damage",
+                        amplification=5.0),  # the factor of its pair 3.11 (thesis line 3998)
                  Figure("figure_3_11_history.png", "Example 3.2-2: tangential displacements",
                         kind="history",
                         fields=(("u_tau_max_top", "max |u_tau| top (g = 1) [m]"),

@@ -1,0 +1,326 @@
+"""One figure style for every PNG of the package (thesis figures, histories, settings).
+
+Rules (GitHub issue 19), each applied here and nowhere else:
+
+* damage on a fixed colour scale [zeta*, 1] -- never autoscaled -- with the label
+  "zeta (1 = sound, zeta* = fully damaged)"; if the field leaves that range (the PDE damage law of
+  Section 2.1 can undershoot) the scale widens to [min, max] and the title prints the extremes;
+* stresses on a shared scale within a thesis pair (:func:`shared_limits`, used when a pair is
+  re-rendered from the saved panel data, see :func:`save_panels` / :func:`render_saved`);
+* amplification factors are round (1, 2, 5 x 10^k, or the factor the thesis states) and written
+  in the title; a factor below 1 is titled "shrunk";
+* deformed-mesh figures: mesh edges of the deformed body over the dashed undeformed outline,
+  no colour field (:func:`render_fields` with ``mesh_only``);
+* tight layouts, colour bars exactly as tall as their axes, mathtext labels (Gamma_D -> Γ_D, ...).
+
+Pure matplotlib/numpy: no dolfinx here (post.py gathers the data and calls these functions).
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+DPI = 150
+DAMAGE_CMAP = "viridis"        # dark = low zeta = damaged (stated in the colour-bar label)
+STRESS_CMAP = "inferno"
+DAMAGE_LABEL = r"$\zeta$ (1 = sound, $\zeta^*$ = fully damaged)"
+#: factors stated in thesis captions (2.12 x3, 3.4 x4); kept as the thesis prints them
+THESIS_FACTORS = (3.0, 4.0)
+
+_MATH = [  # (pattern, replacement), applied in order to ASCII labels
+    (r"\bvon Mises stress\b", r"von Mises stress $\\sigma_{VM}$"),
+    (r"\bvon Mises norm of the strain\b", r"von Mises norm of the strain $\\varepsilon_{VM}$"),
+    (r"\bGamma_([DNC])\b", r"$\\Gamma_\1$"),
+    (r"\bzeta_star\b", r"$\\zeta^*$"),
+    (r"\bdamage zeta\b", "damage"),
+    (r"\bzeta\b", r"$\\zeta$"),
+    (r"\bsigma_tau\b", r"$\\sigma_\\tau$"),
+    (r"\bsigma_nu\b", r"$\\sigma_\\nu$"),
+    (r"\bu_tau\b", r"$u_\\tau$"),
+    (r"\bu_(\d)\b", r"$u_\1$"),
+    (r"\bx(\d)\b", r"$x_\1$"),
+    (r"\beps_reg\b", r"$\\varepsilon$"),
+]
+
+
+def mathtext(label: str) -> str:
+    """ASCII names in a label -> matplotlib mathtext (Gamma_D -> $\\Gamma_D$, zeta -> $\\zeta$,
+    x1 -> $x_1$, u_1 -> $u_1$, von Mises stress -> ... $\\sigma_{VM}$)."""
+    if "$" in label:
+        return label
+    for pattern, repl in _MATH:
+        label = re.sub(pattern, repl, label)
+    return label
+
+
+# ---------------------------------------------------------------------------- amplification
+def round_amplification(a: float) -> float:
+    """The largest factor of the 1-2-5 series (x 10^k) not above ``a`` (0 stays 0)."""
+    if not a or not math.isfinite(a) or a <= 0:
+        return 0.0 if not a else 1.0
+    exp = math.floor(math.log10(a))
+    for m in (5.0, 2.0, 1.0):
+        if m * 10.0 ** exp <= a * (1 + 1e-9):
+            return float(f"{m * 10.0 ** exp:.12g}")
+    return float(f"{10.0 ** exp:.12g}")
+
+
+def is_round(a: float) -> bool:
+    """True for 0 (undeformed), the 1-2-5 series and the thesis's own factors."""
+    if a == 0 or a in THESIS_FACTORS:
+        return True
+    return a > 0 and abs(round_amplification(a) - a) <= 1e-9 * a
+
+
+def drawn_amplification(a: float) -> float:
+    """The factor a figure is drawn with: ``a`` if round (or a thesis factor), else rounded."""
+    return a if is_round(a) else round_amplification(a)
+
+
+def amplification_text(a: float) -> str:
+    """How the title states the factor ('' for the undeformed configuration)."""
+    if not a:
+        return "undeformed configuration"
+    if a == 1:
+        return "true displacements (×1)"
+    if a < 1:
+        return f"displacements shrunk ×{a:g}"
+    return f"displacements ×{a:g}"
+
+
+# ---------------------------------------------------------------------------- colour limits
+def is_damage(name: str, label: str = "") -> bool:
+    return name == "zeta" or "zeta" in label.lower() or "damage" in label.lower()
+
+
+def damage_limits(values, zeta_star: float, tol: float = 1e-9):
+    """(vmin, vmax, note): [zeta*, 1] unless the field leaves it; then the actual extremes,
+    and ``note`` says so (printed in the panel title)."""
+    v = np.asarray(values, float)
+    lo, hi = float(np.nanmin(v)), float(np.nanmax(v))
+    vmin, vmax, notes = zeta_star, 1.0, []
+    if lo < zeta_star - tol:
+        vmin = lo
+        notes.append(f"min $\\zeta$ = {lo:.3g} < $\\zeta^*$")
+    if hi > 1 + tol:
+        vmax = hi
+        notes.append(f"max $\\zeta$ = {hi:.3g} > 1")
+    return vmin, vmax, "; ".join(notes)
+
+
+def shared_limits(arrays):
+    """(0, max) over several arrays: one stress scale for the panels of a thesis pair."""
+    return 0.0, max(float(np.nanmax(np.asarray(a, float))) for a in arrays)
+
+
+# ---------------------------------------------------------------------------- drawing
+def plt():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as pyplot
+    pyplot.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
+                            "mathtext.fontset": "dejavusans"})
+    return pyplot
+
+
+def data_aspect(xy) -> float:
+    """Height / width of the body's bounding box (sizes the figure to the content)."""
+    pts = np.asarray(xy).reshape(-1, 2)
+    w, h = np.ptp(pts[:, 0]), np.ptp(pts[:, 1])
+    return float(np.clip(h / w if w > 0 else 1.0, 0.25, 2.5))
+
+
+def new_figure(npanels: int, aspect: float, panel_width: float = 4.2):
+    """Figure with ``npanels`` side-by-side axes of the body's aspect ratio (no empty bands)."""
+    pyplot = plt()
+    width = panel_width * npanels + 0.3
+    fig, axes = pyplot.subplots(1, npanels, figsize=(width, panel_width * aspect + 0.9),
+                                squeeze=False)
+    return fig, list(axes[0])
+
+
+def colorbar(fig, ax, mappable, label, ticks=None):
+    """A colour bar exactly as tall as ``ax``."""
+    from mpl_toolkits.axes_grid1 import make_axes_locatable
+    cax = make_axes_locatable(ax).append_axes("right", size="4.5%", pad=0.06)
+    cb = fig.colorbar(mappable, cax=cax, ticks=ticks)
+    cb.set_label(label, fontsize=8.5)
+    cb.ax.tick_params(labelsize=7.5)
+    return cb
+
+
+def damage_ticks(vmin, vmax, zeta_star):
+    ticks = [t for t in np.linspace(0, 1, 6) if vmin <= t <= vmax]
+    if vmin <= zeta_star <= vmax and all(abs(t - zeta_star) > 0.05 * (vmax - vmin) for t in ticks):
+        ticks = [zeta_star] + ticks
+    if vmin < zeta_star:
+        ticks = [vmin] + [t for t in ticks if t - vmin > 0.08 * (vmax - vmin)]
+    return sorted(ticks)
+
+
+def boundary_edges(xy):
+    """Edges of a triangle soup (nc, 3, 2) that belong to one triangle only (the outline)."""
+    edges = np.concatenate([xy[:, [0, 1]], xy[:, [1, 2]], xy[:, [2, 0]]])
+    a, b = np.round(edges[:, 0], 9), np.round(edges[:, 1], 9)
+    swap = ((a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1])))[:, None]
+    key = np.hstack([np.where(swap, b, a), np.where(swap, a, b)])
+    _, idx, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
+    return edges[idx[counts == 1]]
+
+
+def draw_outline(ax, ref_xy, label="undeformed outline"):
+    from matplotlib.collections import LineCollection
+    ax.add_collection(LineCollection(boundary_edges(ref_xy), colors="tab:red", linewidths=0.8,
+                                     linestyles="--", label=label, zorder=3))
+
+
+def draw_mesh_edges(ax, xy, lw=None):
+    from matplotlib.collections import PolyCollection
+    lw = lw or (0.35 if len(xy) < 3000 else 0.2)
+    ax.add_collection(PolyCollection(xy, facecolors="none", edgecolors="k", linewidths=lw,
+                                     zorder=2))
+
+
+def _triangulation(xy):
+    import matplotlib.tri as mtri
+    pts = xy.reshape(-1, 2)
+    return mtri.Triangulation(pts[:, 0], pts[:, 1], np.arange(pts.shape[0]).reshape(-1, 3))
+
+
+def _frame(ax, xy_list):
+    pts = np.concatenate([np.asarray(x).reshape(-1, 2) for x in xy_list])
+    lo, hi = pts.min(0), pts.max(0)
+    pad = 0.03 * max(hi - lo)
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel(r"$x_1$ [m]")
+    ax.set_ylabel(r"$x_2$ [m]")
+
+
+def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_star=None,
+                  mesh_only=False, limits=None):
+    """Draw the panels of one figure. ``panels``: list of dicts with ``xy`` (nc, 3, 2) deformed
+    triangles, ``values`` (nc, 3) P1 or (nc,) DG0, ``name`` and ``label``. ``limits``: optional
+    {panel index: (vmin, vmax)} (shared pair scales). Returns the colour limits used per panel
+    (None for a mesh-only panel)."""
+    pyplot = plt()
+    nplot = 1 if mesh_only else len(panels)
+    allxy = [p["xy"] for p in panels] + ([ref_xy] if ref_xy is not None else [])
+    fig, axes = new_figure(nplot, data_aspect(np.concatenate([np.asarray(x).reshape(-1, 2)
+                                                               for x in allxy])))
+    used, notes = [], []
+    for i, ax in enumerate(axes):
+        p = panels[i]
+        xy, vals = np.asarray(p["xy"]), np.asarray(p["values"])
+        if mesh_only:
+            draw_mesh_edges(ax, xy)
+            ax.set_title("deformed mesh and undeformed outline (dashed)")
+            used.append(None)
+        else:
+            tri = _triangulation(xy)
+            damage = is_damage(p.get("name", ""), p.get("label", ""))
+            if damage and zeta_star is not None:
+                vmin, vmax, note = damage_limits(vals, zeta_star)
+                cmap, label = DAMAGE_CMAP, DAMAGE_LABEL
+                notes.append(note)
+            else:
+                vmin, vmax = (limits or {}).get(i) or (0.0, float(np.nanmax(vals)) or 1.0)
+                cmap, label, note = STRESS_CMAP, mathtext(p.get("label", "")), ""
+            if vals.ndim == 2:
+                im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap=cmap,
+                                  vmin=vmin, vmax=vmax)
+            else:
+                im = ax.tripcolor(tri, facecolors=vals, cmap=cmap, vmin=vmin, vmax=vmax)
+            ticks = damage_ticks(vmin, vmax, zeta_star) if damage and zeta_star is not None else None
+            cb = colorbar(fig, ax, im, label, ticks)
+            if not ticks:
+                cb.formatter.set_powerlimits((-3, 4))
+                cb.update_ticks()
+            if damage:
+                ax.set_title("damage $\\zeta$" + (f"\n{note}" if note else ""),
+                             color="firebrick" if note else "k")
+            else:
+                ax.set_title(re.sub(r"\s*\[[^]]*\]$", "", label))
+            used.append((vmin, vmax))
+        if ref_xy is not None:
+            draw_outline(ax, np.asarray(ref_xy))
+        _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else []))
+    full = mathtext(title) + (f" — {amplification_text(amplification)}"
+                              if amplification != 1 or mesh_only else "")
+    fig.tight_layout()
+    suptitle_on_top(fig, full)
+    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    pyplot.close(fig)
+    return used
+
+
+def suptitle_on_top(fig, text):
+    """The figure title just above the axes' titles (equal-aspect axes shrink inside their
+    slot; a default suptitle would float over an empty band)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    inv = fig.transFigure.inverted()
+    top = max(ax.get_tightbbox(renderer).transformed(inv).y1 for ax in fig.axes)
+    fig.suptitle(text, y=top + 0.01, va="bottom")
+
+
+def save_panels(path, panels, **meta):
+    """The data behind a field figure (``<png>.npz`` + JSON meta), so that a thesis pair can be
+    re-rendered on a shared stress scale after both runs finished (:func:`render_saved`)."""
+    path = Path(path)
+    arrays = {}
+    for i, p in enumerate(panels):
+        arrays[f"xy{i}"], arrays[f"v{i}"] = np.asarray(p["xy"]), np.asarray(p["values"])
+    if meta.get("ref_xy") is not None:
+        arrays["ref_xy"] = np.asarray(meta.pop("ref_xy"))
+    else:
+        meta.pop("ref_xy", None)
+    meta["panels"] = [{"name": p.get("name", ""), "label": p.get("label", "")} for p in panels]
+    arrays["meta"] = np.array(json.dumps(meta))
+    np.savez_compressed(path.with_suffix(".npz"), **arrays)
+
+
+def load_panels(npz):
+    d = np.load(npz)
+    meta = json.loads(str(d["meta"]))
+    panels = [dict(info, xy=d[f"xy{i}"], values=d[f"v{i}"]) for i, info in enumerate(meta["panels"])]
+    return panels, meta, (d["ref_xy"] if "ref_xy" in d else None)
+
+
+def render_saved(npz, png, limits=None) -> list:
+    panels, meta, ref = load_panels(npz)
+    return render_fields(panels, png, title=meta.get("title", ""),
+                         amplification=meta.get("amplification", 1.0), ref_xy=ref,
+                         zeta_star=meta.get("zeta_star"), mesh_only=meta.get("mesh_only", False),
+                         limits=limits)
+
+
+def render_pair(npz_a, npz_b, png_a, png_b):
+    """Re-render two figures of a thesis pair with one stress scale per non-damage panel."""
+    (pa, ma, _), (pb, mb, _) = load_panels(npz_a), load_panels(npz_b)
+    limits = {}
+    for i, (a, b) in enumerate(zip(pa, pb)):
+        if not is_damage(a["name"], a["label"]):
+            limits[i] = shared_limits([a["values"], b["values"]])
+    return render_saved(npz_a, png_a, limits), render_saved(npz_b, png_b, limits)
+
+
+def legend_below(ax, ncol=3):
+    """Legend under the axes (never over the mesh)."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=ncol,
+                  fontsize=8, frameon=False)
+
+
+def save(fig, path, title=None):
+    fig.tight_layout()
+    if title:
+        suptitle_on_top(fig, title)
+    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    plt().close(fig)
