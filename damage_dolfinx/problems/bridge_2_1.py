@@ -10,7 +10,22 @@ Failure (thesis, Section 2.1 Example 3): "collapse occurs at the loading step fo
 cross-section of the bridge reaches the lower bound for the damage zeta_*". A cross-section is a
 radial grid line j of the ring (n_r + 1 nodes on the structured mesh; on an unstructured mesh the
 nodes whose polar angle is nearest to theta_j); it has failed when the maximum of zeta_n over
-its nodes is <= zeta_star. The failure load is P(t_n) at the first such step n.
+its nodes is <= zeta_star (+ ZETA_STAR_TOL). The failure load is P(t_n) at the first such step n.
+
+Damage bound (issue 16; ``damage_bound``): with the thesis data the source violates the sign
+condition (2.11) (thesis lines 752-758: phi >= 0 for zeta <= zeta_star would need
+lam_D (1 - zeta_star)/zeta_star = 0.198 >= 0.5 lam_u |eps^+-|^2, i.e. strains below 9e-6), so the
+linear step (2.20) drives zeta_n far below zeta_star (-1200 at h = 0.05 before collapse) and the
+diffusion spreads the undershoot. The thesis keeps zeta in [zeta_star, 1]: Theorem 2.1 (line 814),
+the truncation eta_* onto [zeta_star, 1] (lines 359-361, (2.2)-(2.3) lines 718-720), and for the
+bridge "a whole cross-section reaches the lower bound for the damage zeta_star" (line 1123), which
+needs nodes that reach zeta_star and stay there while the run goes on. "obstacle" (default)
+solves each step (2.20) as the obstacle problem over K^h = {zeta_star <= zeta <= 1} (the discrete
+problem (2.96), line 1566, of the other sections, whose bound and reason are lines 1154-1172),
+with the Section 2.1 source unchanged; it equals (2.20) wherever the linear step stays in
+[zeta_star, 1]. "clamp" truncates the nodal values of the linear step, zeta_n <- eta_*(zeta_n):
+with the consistent mass matrix it leaves checkerboard oscillations in the damaged zones.
+"none" is the literal linear step (2.20) (its figures are coloured over the data range).
 
 Hinges (the mechanism, thesis Figures 2.8-2.9): the sections where damage localises. For every
 section the *section damage* D_j = 1 - mean of eta_*(zeta_n) over its nodes is the average
@@ -34,6 +49,8 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from .. import compat
+from ..constitutive import eps
+from ..damage import DamageStep, source
 from damage_dolfinx.geometries import GAMMA_N
 from ..parameters import InputError
 from .base import ProblemData
@@ -48,7 +65,16 @@ BRIDGE_DEFAULTS = {
     "hinge_damage": 0.3,     # a hinge is a peak of the section damage D_j of at least this height
     "hinge_prominence": 0.2,  # ... standing out by at least this much (scipy find_peaks)
     "hinge_separation": 0.0,  # merge peaks closer than this [m]; 0 = one ring thickness
+    "damage_bound": "obstacle",  # keep zeta_n in [zeta_star, 1] (module docstring): "obstacle",
+                                 # "clamp", or "none" (the literal linear step (2.20))
 }
+
+#: values of ``damage_bound``
+DAMAGE_BOUNDS = ("obstacle", "clamp", "none")
+
+#: a section has failed when max zeta_n over its nodes <= zeta_star + ZETA_STAR_TOL (the bound
+#: is met to solver round-off)
+ZETA_STAR_TOL = 1e-9
 
 
 def _allreduce(comm, array: np.ndarray, op) -> np.ndarray:
@@ -66,10 +92,30 @@ def check_bridge_parameters(extra: dict):
              "hinge_damage": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
              "hinge_prominence": (lambda v: 0 <= v < 1, "must lie in [0, 1)"),
              "hinge_separation": (lambda v: v >= 0, "(m) must be >= 0")}
+    bound = extra.get("damage_bound", BRIDGE_DEFAULTS["damage_bound"])
+    if bound not in DAMAGE_BOUNDS:
+        raise InputError(f"damage_bound must be one of {', '.join(DAMAGE_BOUNDS)}, got "
+                         f"damage_bound = {bound!r}")
     for name, (ok, text) in rules.items():
         value = extra.get(name, BRIDGE_DEFAULTS[name])
         if not isinstance(value, (int, float)) or not math.isfinite(value) or not ok(value):
             raise InputError(f"{name} {text}, got {name} = {value!r}")
+
+
+class _ClampedStep:
+    """The linear step (2.20) followed by the nodal truncation zeta_n <- eta_*(zeta_n)."""
+
+    def __init__(self, step, zeta_star: float):
+        self.step, self.zeta, self.zeta_star = step, step.zeta, zeta_star
+
+    def solve(self) -> int:
+        its = self.step.solve()
+        np.clip(self.zeta.x.array, self.zeta_star, 1.0, out=self.zeta.x.array)
+        return its
+
+    @property
+    def iterations(self) -> int:
+        return self.step.iterations
 
 
 class BridgeDamage(ElasticDamage):
@@ -89,11 +135,27 @@ class BridgeDamage(ElasticDamage):
         check_bridge_parameters(extra)
         self.bridge = extra
         super().__init__(data, **kwargs)
+        self._bound_damage(kwargs.get("damage_prefix", "damage_"))
         self._setup_sections(geo)
         self._patch_uy = compat.form(self.u[1] * self._dsN)
         self.failure: Optional[dict] = None
         self._hinges = []
-        self.zeta.plot_range = (0.0, 1.0)  # PDE damage may undershoot: colour [0, 1], clipped
+        self.zeta_min_run = float("inf")  # min over nodes and steps of zeta_n
+
+    def _bound_damage(self, prefix):
+        """Replace the linear damage step (2.20) by one that keeps zeta_n in [zeta_star, 1]
+        (``damage_bound``, module docstring); "none" keeps the literal step."""
+        p, bound = self.params, self.bridge["damage_bound"]
+        if bound == "obstacle":
+            phi_old = source(eps(self.u), self.zeta_old, p)
+            self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, self.k, self.kappa,
+                                     self.context, obstacle=True, zeta_star=p.zeta_star,
+                                     prefix=prefix)
+        elif bound == "clamp":
+            self.damage = _ClampedStep(self.damage, p.zeta_star)
+        # colour range of the damage figures: the admissible set [zeta_star, 1]; the literal
+        # step is drawn over its own range so that an undershoot below zeta_star stays visible
+        self.zeta.plot_range = None if bound == "none" else (p.zeta_star, 1.0)
 
     # -- loads (G3)
     def loads(self):
@@ -181,6 +243,12 @@ class BridgeDamage(ElasticDamage):
                  "section_damage": round(float(D[j[i]]), 4), "zeta_max": float(stats["zeta_max"][j[i]]),
                  "damaged_face": str(face[i])} for i in range(j.size)]
 
+    def iteration_totals(self) -> dict:
+        out = super().iteration_totals()
+        if self.bridge["damage_bound"] == "obstacle":  # the damage step is a VI: Newton its
+            out["snes"] = out.pop("damage_ksp")
+        return out
+
     # -- runner hooks
     def scalars(self) -> dict:
         """Base scalars plus load, displacement under the load, weakest section, hinges; detects
@@ -191,10 +259,11 @@ class BridgeDamage(ElasticDamage):
         hinges = self.hinges(stats)
         self._hinges = hinges
         u_y = compat.assemble_scalar(self._patch_uy, self.comm) / self.patch_length
+        self.zeta_min_run = min(self.zeta_min_run, float(stats["zeta_min"].min()))
         out.update(P_kN=self.load_kN(), u_load_y=u_y, weakest_section=weakest,
                    weakest_section_zeta_max=float(stats["zeta_max"][weakest]),
                    n_hinges=len(hinges))
-        failed = np.flatnonzero(stats["zeta_max"] <= self.params.zeta_star)
+        failed = np.flatnonzero(stats["zeta_max"] <= self.params.zeta_star + ZETA_STAR_TOL)
         if failed.size and self.failure is None and self.n > 0:
             pts = self.data.geometry.section_points(failed)
             self.failure = {"step": self.n, "t": self.t, "P_kN": self.load_kN(),
@@ -223,6 +292,7 @@ class BridgeDamage(ElasticDamage):
             "failure_u_load_y": None if f is None else f["u_load_y"],
             "failure_section_damage": None if f is None else f["section_damage"],
             "load_increment_kN": self.bridge["load_rate"] * self.data.time.k,
+            "damage_bound": self.bridge["damage_bound"], "zeta_min_run": self.zeta_min_run,
             "hinges": hinges, "n_hinges": len(hinges),
             "hinge_definition": {"section_damage": "D_j = 1 - mean eta_*(zeta) over section j",
                                  "min_height": self.bridge["hinge_damage"],
