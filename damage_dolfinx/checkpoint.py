@@ -1,11 +1,14 @@
 """Checkpoint/restart of long runs, independent of the number of MPI ranks.
 
-A checkpoint is ``checkpoint.npz`` (the stepper's state Functions, gathered on rank 0 and keyed
-by partition-independent dof positions) plus ``checkpoint.json`` (step, time, run settings). Both
-are written atomically (temporary file + rename), so a run killed at any moment leaves the last
-complete checkpoint. On restart each rank finds its owned dofs among the saved keys by one
-vectorised sort (no point search, no Python loop over dofs), so a run can resume on a different
-number of ranks.
+A checkpoint is ``checkpoint.npz``: the stepper's state Functions, gathered on rank 0 and keyed
+by partition-independent dof positions, and its metadata (step, time, run settings; ``__meta__``,
+also copied to ``checkpoint.json`` for people and scripts). Generations: a new checkpoint is
+written completely to ``checkpoint.npz.tmp`` (fsync) before the previous one is renamed to
+``checkpoint.prev.npz`` and the new one into place, so a run killed at any moment, or a full disk,
+leaves at least one complete checkpoint; a restart takes the newest readable one (``latest``:
+every array is read, so a truncated or empty file is detected) and says when it falls back. On
+restart each rank finds its owned dofs among the saved keys by one vectorised sort (no point
+search, no Python loop over dofs), so a run can resume on a different number of ranks.
 
 Keys: the dof coordinates for continuous (P1) spaces; for discontinuous spaces (DG0 stresses of
 2.4, DG1 memory of 2.3), whose dofs share coordinates, the coordinates plus the midpoint of the
@@ -15,12 +18,13 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
-from . import compat
+from . import compat, io
 from .parameters import InputError
 
 FORMAT = "damage-dolfinx/checkpoint/v1"
@@ -33,7 +37,7 @@ def _owned_keys(f) -> np.ndarray:
     V = f.function_space
     n_owned = V.dofmap.index_map.size_local
     X = V.tabulate_dof_coordinates()[:n_owned, :2]
-    if "Discontinuous" not in V.ufl_element().family():
+    if not compat.is_discontinuous(V):
         return X
     cell_dofs = compat.cell_dofs(V)
     dof_cell = np.empty(n_owned, dtype=np.int64)
@@ -49,32 +53,76 @@ def _values(f) -> np.ndarray:
     return f.x.array.reshape(-1, V.dofmap.index_map_bs)[:V.dofmap.index_map.size_local]
 
 
+#: newest first; the temporary file counts only if complete (a kill between the two renames)
+GENERATIONS = ("checkpoint.npz", "checkpoint.prev.npz", "checkpoint.npz.tmp")
+
+
 def save(out, state: dict, meta: dict, comm=MPI.COMM_WORLD):
-    """Write the checkpoint of ``state`` (name -> Function) and ``meta`` (JSON-able)."""
+    """Write the checkpoint of ``state`` (name -> Function) and ``meta`` (JSON-able), keeping
+    the previous generation. A failed write (disk full) raises io.OutputError on every rank and
+    leaves the earlier checkpoints as they were."""
     out = Path(out)
     gathered = {}
     for name, f in state.items():
         keys, vals = comm.gather(_owned_keys(f), root=0), comm.gather(_values(f), root=0)
         if comm.rank == 0:
             gathered[name + "__keys"], gathered[name] = np.concatenate(keys), np.concatenate(vals)
-    if comm.rank == 0:
-        tmp = out / "checkpoint.tmp.npz"
-        np.savez(tmp, **gathered)
-        os.replace(tmp, out / "checkpoint.npz")
-        tmp_json = out / "checkpoint.json.tmp"
-        tmp_json.write_text(json.dumps({"format": FORMAT, **meta}, indent=2) + "\n")
-        os.replace(tmp_json, out / "checkpoint.json")
-    comm.barrier()
+    text = json.dumps({"format": FORMAT, **meta}, indent=2) + "\n"
+    gathered["__meta__"] = np.array(text)
+
+    def write():
+        if comm.rank != 0:
+            return
+        newest = out / GENERATIONS[0]
+        io.atomic_write_bytes(out / GENERATIONS[2], lambda f: np.savez(f, **gathered), fsync=True)
+        # the complete new file exists: the previous generation can move aside
+        if newest.exists():
+            os.replace(newest, out / GENERATIONS[1])
+        os.replace(out / GENERATIONS[2], newest)
+        io.write_json(out / "checkpoint.json", json.loads(text))
+
+    what = f"checkpoint.npz at step {meta.get('step')} (t = {meta.get('t', 0):.6g})"
+    io.collective(comm, out, what, write)
 
 
-def read_meta(out) -> dict:
-    path = Path(out) / "checkpoint.json"
-    if not path.is_file():
-        raise InputError(f"cannot restart: no checkpoint in {str(out)!r} (checkpoint.json missing)")
-    meta = json.loads(path.read_text())
-    if meta.get("format") != FORMAT:
-        raise InputError(f"cannot restart: {path} is not a {FORMAT} checkpoint")
-    return meta
+def latest(out, comm=MPI.COMM_WORLD):
+    """(file, meta) of the newest readable checkpoint in ``out``; a fallback to an older
+    generation is announced on stderr (rank 0). Raises InputError if there is none."""
+    result = _latest(Path(out)) if comm.rank == 0 else None
+    path, meta, notes, error = comm.bcast(result, root=0)
+    if error:
+        raise InputError(error)
+    if notes and comm.rank == 0:
+        print(f"damage-dolfinx: {'; '.join(notes)}; restarting from {path.name} "
+              f"(step {meta['step']})", file=sys.stderr, flush=True)
+    return path, meta
+
+
+def _latest(out: Path):
+    notes = []
+    for name in GENERATIONS:
+        path = out / name
+        if not path.exists():
+            continue
+        try:
+            with np.load(path) as data:
+                for key in data.files:
+                    data[key]  # reads (and CRC-checks) every array
+                meta = json.loads(str(data["__meta__"])) if "__meta__" in data.files else \
+                    json.loads((out / "checkpoint.json").read_text())  # pre-generation format
+        except Exception as exc:  # noqa: BLE001 - any unreadable file: try the next generation
+            if name != GENERATIONS[2]:
+                size = path.stat().st_size
+                notes.append(f"{name} is unreadable ({type(exc).__name__}, {size} bytes)")
+            continue
+        if meta.get("format") != FORMAT:
+            notes.append(f"{name} is not a {FORMAT} checkpoint")
+            continue
+        return path, meta, notes, None
+    if not notes:
+        return None, None, [], (f"cannot restart: no checkpoint in {str(out)!r} "
+                                "(checkpoint.npz missing)")
+    return None, None, [], f"cannot restart: no readable checkpoint in {str(out)!r} ({'; '.join(notes)})"
 
 
 def _match(saved: np.ndarray, local: np.ndarray) -> np.ndarray:
@@ -93,9 +141,10 @@ def _match(saved: np.ndarray, local: np.ndarray) -> np.ndarray:
     return before
 
 
-def load(out, state: dict):
-    """Set every Function of ``state`` from the checkpoint in ``out`` (any number of ranks)."""
-    data = np.load(Path(out) / "checkpoint.npz")
+def load(path, state: dict):
+    """Set every Function of ``state`` from the checkpoint file ``path`` (from ``latest``; any
+    number of ranks)."""
+    data = np.load(path)
     for name, f in state.items():
         if name not in data:
             raise InputError(f"cannot restart: the checkpoint has no field {name!r}")

@@ -2,14 +2,21 @@
 
 Everything is written incrementally: the XDMF file is re-opened in append mode for each output
 time and the CSV row is flushed after each step, so an interrupted run keeps every finished step.
-Only rank 0 writes CSV/JSON/NPZ; XDMF is collective.
+Only rank 0 writes CSV/JSON/NPZ; XDMF is collective. JSON and NPZ files are written to a temporary
+file and renamed (a kill never leaves a truncated file); the history is appended row by row (a
+full disk can truncate at most its last row, which a restart drops). A write that fails on any
+rank raises OutputError on every rank (``collective``), so ranks never wait for each other.
 """
 from __future__ import annotations
 
 import csv
+import errno
+import fcntl
 import json
 import os
 import platform
+import shutil
+import socket
 import sys
 import time
 from pathlib import Path
@@ -39,14 +46,61 @@ def prepare_output_dir(path, comm=MPI.COMM_WORLD) -> Path:
     return path
 
 
+class OutputError(Exception):
+    """An output file could not be written (disk full, I/O error, folder deleted); one line."""
+
+
+def describe(exc: BaseException, folder=None) -> str:
+    """One line for an I/O exception (HDF5 reports a full disk only as 'Failed to close ...')."""
+    text = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc).splitlines()[0]
+    if folder is not None and not (isinstance(exc, OSError) and exc.errno == errno.ENOSPC):
+        try:
+            if shutil.disk_usage(folder).free < 1 << 16:
+                text += " (the disk is full)"
+        except OSError:
+            text += " (the output folder is gone)"
+    return text
+
+
+def collective(comm, folder, what: str, fn, *args):
+    """Run the write ``fn(*args)`` on every rank; an OSError/RuntimeError on any rank raises
+    OutputError("cannot write WHAT: reason") on every rank (``what`` names file, step and time)."""
+    error = None
+    try:
+        fn(*args)
+    except (OSError, RuntimeError) as exc:
+        error = describe(exc, folder)
+    error = next((e for e in comm.allgather(error) if e), None)
+    if error:
+        raise OutputError(f"cannot write {what}: {error}")
+
+
+def atomic_write_bytes(path, write, fsync=False):
+    """Write a file through ``write(fileobj)`` into ``path.tmp`` and rename it onto ``path``;
+    the temporary file is removed if anything fails (so a full disk gets its space back)."""
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        with open(tmp, "wb") as f:
+            write(f)
+            f.flush()
+            if fsync:
+                os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        raise
+
+
 def write_json(path, data, comm=MPI.COMM_WORLD):
-    """Atomically write ``data`` as JSON (rank 0)."""
+    """Atomically write ``data`` as JSON (rank 0; raises OSError there)."""
     if comm.rank != 0:
         return
-    path = Path(path)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(data, indent=2, sort_keys=False, default=_json_default) + "\n")
-    os.replace(tmp, path)
+    text = json.dumps(data, indent=2, sort_keys=False, default=_json_default) + "\n"
+    atomic_write_bytes(path, lambda f: f.write(text.encode()))
 
 
 def _json_default(obj):
@@ -71,33 +125,58 @@ def environment(comm=MPI.COMM_WORLD) -> dict:
 
 
 class CSVHistory:
-    """One CSV row per time step, flushed immediately (rank 0)."""
+    """One CSV row per time step, appended and flushed immediately (rank 0). A failed write is
+    kept in ``error`` (the runner checks it collectively at the end of the step) instead of
+    raising on rank 0 alone."""
 
     def __init__(self, path, columns, comm=MPI.COMM_WORLD, keep_until_step=None):
-        """A new file, or with ``keep_until_step`` (restart) the existing rows of steps up to
-        that one followed by the new rows."""
-        self.columns, self.comm = list(columns), comm
-        self._file = None
+        """A new file, or with ``keep_until_step`` (restart) the existing complete rows of steps
+        up to that one followed by the new rows; the file is replaced atomically, then appended.
+        Raises OSError (rank 0)."""
+        self.columns, self.comm, self.path = list(columns), comm, Path(path)
+        self._file, self.error = None, None
         if comm.rank == 0:
-            kept = []
-            if keep_until_step is not None and Path(path).is_file():
-                with open(path, newline="") as f:
-                    kept = [r for r in csv.DictReader(f) if int(r["step"]) <= keep_until_step]
-            self._file = open(path, "w", newline="")
+            kept = self.read_rows(path, keep_until_step) if keep_until_step is not None else []
+
+            def write(f):
+                import io as _io
+                text = _io.TextIOWrapper(f, newline="", encoding="utf-8")
+                writer = csv.DictWriter(text, fieldnames=self.columns)
+                writer.writeheader()
+                for row in kept:
+                    writer.writerow({c: row.get(c, "") for c in self.columns})
+                text.flush()
+                text.detach()
+            atomic_write_bytes(path, write)
+            self._file = open(path, "a", newline="")
             self._writer = csv.DictWriter(self._file, fieldnames=self.columns)
-            self._writer.writeheader()
-            for row in kept:
-                self._writer.writerow({c: row.get(c, "") for c in self.columns})
-            self._file.flush()
+
+    @staticmethod
+    def read_rows(path, until_step) -> list:
+        """Complete rows (all columns, ending in a newline) of steps <= until_step."""
+        if not Path(path).is_file():
+            return []
+        text = Path(path).read_text()
+        if text and not text.endswith("\n"):  # a row cut by a full disk
+            text = text[:text.rfind("\n") + 1]
+        rows = csv.DictReader(text.splitlines())
+        return [r for r in rows if None not in r.values() and None not in r
+                and r["step"].isdigit() and int(r["step"]) <= until_step]
 
     def write(self, row: dict):
-        if self._file is not None:
-            self._writer.writerow({c: row.get(c, "") for c in self.columns})
-            self._file.flush()
+        if self._file is not None and self.error is None:
+            try:
+                self._writer.writerow({c: row.get(c, "") for c in self.columns})
+                self._file.flush()
+            except OSError as exc:
+                self.error = exc
 
     def close(self):
         if self._file is not None:
-            self._file.close()
+            try:
+                self._file.close()
+            except OSError:
+                pass  # a full disk: the rows that were flushed stay
             self._file = None
 
 
@@ -142,4 +221,67 @@ def save_final_fields(path, functions: dict):
         if gathered is not None:
             data[name + "_coords"], data[name] = gathered
     if data:
-        np.savez(path, **data)
+        atomic_write_bytes(path, lambda f: np.savez(f, **data))
+
+
+class RunLock:
+    """``out/.lock``, held (flock) by rank 0 of the live run; the kernel drops it when that
+    process dies, even by SIGKILL, so a dead run never blocks a new one. Raises InputError when
+    a live run holds it. Where the file system has no flock, a lock whose process is gone (same
+    host) is taken over."""
+
+    def __init__(self, out, comm=MPI.COMM_WORLD):
+        self.path, self.comm, self._fd = Path(out) / ".lock", comm, None
+        error = self._acquire() if comm.rank == 0 else None
+        error = comm.bcast(error, root=0)
+        if error:
+            raise InputError(error)
+
+    def _acquire(self):
+        for _ in range(10):  # the file may be replaced between open and flock (see release)
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                holder = os.read(fd, 1000).decode(errors="replace").strip()
+                os.close(fd)
+                return f"a run is live in {str(self.path.parent)!r} ({holder or 'see .lock'}); " \
+                       f"wait for it to end or stop it (a dead run's lock is released at once)"
+            except OSError:  # no flock on this file system: the recorded process must be gone
+                holder = os.read(fd, 1000).decode(errors="replace").split()
+                if len(holder) >= 4 and _alive(holder[1], holder[3]):
+                    os.close(fd)
+                    return f"a run is live in {str(self.path.parent)!r} (pid {holder[1]})"
+            try:
+                same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                os.ftruncate(fd, 0)
+                os.pwrite(fd, f"pid {os.getpid()} host {socket.gethostname()} since "
+                              f"{time.strftime('%Y-%m-%dT%H:%M:%S')}\n".encode(), 0)
+                self._fd = fd
+                return None
+            os.close(fd)
+        return f"cannot lock {self.path}"
+
+    def release(self):
+        if self._fd is not None:
+            try:
+                self.path.unlink()  # before unlocking: a waiting opener then retries
+            except OSError:
+                pass
+            os.close(self._fd)
+            self._fd = None
+
+
+def _alive(pid, host) -> bool:
+    if host != socket.gethostname():
+        return True  # cannot tell: assume live
+    try:
+        os.kill(int(pid), 0)
+    except (ProcessLookupError, ValueError):
+        return False
+    except PermissionError:
+        return True
+    return True

@@ -4,21 +4,30 @@
 remove or rename them):
 
     schema, example, title, section, status ("running" | "completed" | "zeta_star_reached" |
-    "failed"), error (if failed), parameters (all model parameters), n, h, k, T, num_steps
+    "failed" | "interrupted"), error (if failed), signal (if interrupted), parameters (all model parameters), n, h, k, T, num_steps
     (planned), steps_done, t_final, mpi_size, wall_time_s, timings_s, iterations (total solver
     iterations: damage_ksp, mech_ksp, snes), mesh (cells, vertices, dofs, h, description),
     final (u_L2, eps_u_L2, zeta_min, zeta_max, zeta_mean at t_final), assumptions, outputs
     (file names), environment (versions, MPI size, command, date).
 
-The file is rewritten at every output time, so an interrupted run leaves a readable summary
-with status "running" and the CSV history of every finished step.
+The file is rewritten (atomically) at every output time, so a killed run leaves a readable
+summary with status "running" and the CSV history of every finished step. Faults (README,
+Command line): a full disk or another output error stops the run with io.OutputError after
+marking the summary "failed" where space allows; SIGTERM/SIGINT/SIGUSR1 stop it at the end of
+the step with a checkpoint and status "interrupted" (RunInterrupted); io.RunLock refuses a
+second run into a folder where one is live.
 """
 from __future__ import annotations
 
+import json
 import math
+import os
+import signal
+import threading
 import time
 from pathlib import Path
 
+import numpy as np
 from mpi4py import MPI
 
 from . import checkpoint, examples, io, post
@@ -48,31 +57,108 @@ class Progress:
 
 #: default wall-time interval between checkpoints (seconds)
 CHECKPOINT_SECONDS = 120.0
+#: signals that stop a run at the end of the current step, with a checkpoint; mpirun (Open MPI)
+#: forwards SIGUSR1 to every rank, while it answers SIGTERM/SIGINT by killing the ranks
+STOP_SIGNALS = (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1)
+#: statuses of a run that has nothing left to do (a larger T continues a "completed" one)
+FINISHED = ("completed", "zeta_star_reached", "collapse")
+#: files of a run that --overwrite removes (figures are overwritten by the new run)
+RUN_FILES = ("summary.json", "history.csv", "fields_final.npz", "checkpoint.json",
+             *checkpoint.GENERATIONS)
+
+
+class RunInterrupted(Exception):
+    """The run stopped on a signal after writing a checkpoint; exit status 128 + signal."""
+
+    def __init__(self, signum: int, message: str):
+        super().__init__(message)
+        self.signum, self.exit_status = signum, 128 + signum
+
+
+class StopSignals:
+    """While active, STOP_SIGNALS only set ``signum`` (the runner stops collectively at the end
+    of the step); a second signal ends the process at once (the signal's default action)."""
+
+    def __enter__(self):
+        self.signum, self._previous = 0, {}
+        if threading.current_thread() is threading.main_thread():
+            self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
+        return self
+
+    def _handle(self, signum, frame):
+        if self.signum:
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+        self.signum = signum
+
+    def __exit__(self, *exc):
+        for s, handler in self._previous.items():
+            signal.signal(s, handler)
 
 
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
         write_every=None, progress=True, figures=True, time_limit=None, checkpoint_every=None,
-        checkpoint_seconds=CHECKPOINT_SECONDS, restart=False, comm=MPI.COMM_WORLD) -> dict:
+        checkpoint_seconds=CHECKPOINT_SECONDS, restart=False, overwrite=True,
+        comm=MPI.COMM_WORLD) -> dict:
     """Run one catalogue example and write its outputs to ``out``; returns the summary.
     With ``time_limit`` (seconds) the run stops after the step that exceeds it, with status
     "time_limit" (used by benchmarks that skip cells a solver cannot finish).
 
     Checkpoints (checkpoint.py) are written every ``checkpoint_every`` steps, or else every
-    ``checkpoint_seconds`` of wall time (0: never), and when the run stops early; ``restart``
-    resumes from the checkpoint in ``out`` (same example, mesh, k and parameters; any number
-    of ranks; T may be larger), keeping the history rows up to the checkpoint."""
-    wall_start = time.perf_counter()
+    ``checkpoint_seconds`` of wall time (0 and no ``checkpoint_every``: never), when the run
+    stops early or on a signal, and at its end; ``restart`` resumes from the checkpoint in
+    ``out`` (same example, mesh, k and parameters; any number of ranks; a larger T continues a
+    completed run, otherwise a finished run is left as it is), keeping the history rows up to
+    the checkpoint. A folder holding a run is refused (InputError) unless ``restart`` or
+    ``overwrite`` (the command line passes overwrite=False unless --overwrite); a folder where a
+    run is live is always refused (io.RunLock). Output errors raise io.OutputError, signals
+    RunInterrupted, both after recording the status in summary.json."""
     ex = examples.get(example_id)
-    params, grid, n, h, mesh_file = ex.configure(n, k, T, h, overrides, mesh_file)
+    configured = ex.configure(n, k, T, h, overrides, mesh_file)
+    if restart and not Path(out).is_dir():
+        raise InputError(f"cannot restart: no checkpoint in {str(out)!r} (no such folder)")
+    out = io.prepare_output_dir(out, comm)
+    lock = io.RunLock(out, comm)
+    try:
+        with StopSignals() as signals:
+            return _run(ex, configured, out, n, k, T, h, overrides, write_every, progress,
+                        figures, time_limit, checkpoint_every, checkpoint_seconds, restart,
+                        overwrite, comm, signals)
+    finally:
+        lock.release()
+
+
+def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figures, time_limit,
+         checkpoint_every, checkpoint_seconds, restart, overwrite, comm, signals) -> dict:
+    wall_start = time.perf_counter()
+    params, grid, n, h, mesh_file = configured
     settings = {"example": ex.id, "n": n, "h": h, "k": grid.k, "overrides": overrides or {},
                 "mesh_file": str(mesh_file) if mesh_file else None}
-    resume = _check_restart(out, settings, grid) if restart else None
-    out = io.prepare_output_dir(out, comm)
+    previous = _previous_run(out, comm)
+    resume = None
+    if restart:
+        resume = _check_restart(out, settings, grid, previous, comm)
+        if resume is None:
+            if comm.rank == 0:
+                print(f"damage-dolfinx: nothing to do: the run in {str(out)!r} ended "
+                      f"({previous['status']}) at t = {previous['t_final']:.6g} after "
+                      f"{previous['steps_done']} steps; its outputs are unchanged"
+                      + (" (a larger --T continues it)" if previous["status"] == "completed"
+                         else ""), flush=True)
+            return previous
+    elif previous:
+        if not overwrite:
+            raise InputError(f"{str(out)!r} holds {previous['description']}; --restart continues "
+                             "it, --overwrite replaces it, or choose another --out")
+        io.collective(comm, out, f"(remove) the previous run in {out}", _remove_run_files, out,
+                      comm)
+    path, resume = resume or (None, None)
     stepper = ex.build(comm, n, k, T, h, overrides, mesh_file)
     if (resume or checkpoint_every) and not stepper.checkpoint_supported:
         raise InputError(f"example {ex.id} does not support checkpoints")
     N = stepper.num_steps
     write_every = write_every or max(1, N // 20)
+    checkpoints = stepper.checkpoint_supported and bool(checkpoint_every or checkpoint_seconds)
 
     summary = {"schema": "damage-dolfinx/summary/v1", "example": ex.id, "title": ex.title,
                "section": ex.section, "status": "running", "parameters": params.as_dict(),
@@ -84,33 +170,55 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                "environment": io.environment(comm)}
     xdmf_name = f"fields_from_step{resume['step']}.xdmf" if resume else "fields.xdmf"
     summary["outputs"]["xdmf"] = xdmf_name
-    xdmf = io.XDMFSeries(out / xdmf_name, stepper.mesh)
-    history = io.CSVHistory(out / "history.csv",
-                            ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
-                             "damage_its", "mech_its", "snes_its", "step_time_s",
-                             *stepper.extra_history_columns], comm,
-                            keep_until_step=resume["step"] if resume else None)
+    files = {}  # the XDMF series and the history, created below (collectively checked)
+    columns = ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
+               "damage_its", "mech_its", "snes_its", "step_time_s", *stepper.extra_history_columns]
+
+    def open_files():
+        files["xdmf"] = io.XDMFSeries(out / xdmf_name, stepper.mesh)
+        files["history"] = io.CSVHistory(out / "history.csv", columns, comm,
+                                         keep_until_step=resume["step"] if resume else None)
+    io.collective(comm, out, f"{xdmf_name} / history.csv (opening)", open_files)
+    xdmf, history = files["xdmf"], files["history"]
     report = Progress(ex.id, N, comm, enabled=progress)
     previous_wall = resume["wall_time_s"] if resume else 0.0
     if resume:
         summary["restarts"] = resume.get("restarts", []) + [
             {"step": resume["step"], "mpi_size": comm.size, "previous_mpi_size": resume["mpi_size"]}]
-    last_checkpoint = [time.perf_counter()]
+    last_checkpoint = {"time": time.perf_counter(), "step": resume["step"] if resume else None}
+
+    def at(name):
+        return f"{name} at step {stepper.n} (t = {stepper.t:.6g})"
+
+    def write_summary():
+        io.collective(comm, out, at("summary.json"), io.write_json, out / "summary.json",
+                      summary, comm)
 
     def save_checkpoint():
         checkpoint.save(out, stepper.checkpoint_state(), {
             **settings, "step": stepper.n, "t": stepper.t, "mpi_size": comm.size,
             "wall_time_s": previous_wall + time.perf_counter() - wall_start,
             "restarts": summary.get("restarts", [])}, comm)
-        last_checkpoint[0] = time.perf_counter()
+        last_checkpoint.update(time=time.perf_counter(), step=stepper.n)
 
-    def checkpoint_due() -> bool:
+    def end_of_step():
+        """One allreduce per step: seconds since the last checkpoint and since the start, the
+        signal received (if any) and whether the history row failed, agreed by all ranks."""
+        now = time.perf_counter()
+        state = np.array([now - last_checkpoint["time"], now - wall_start, signals.signum,
+                          float(history.error is not None)])
+        comm.Allreduce(MPI.IN_PLACE, state, op=MPI.MAX)
+        if state[3]:
+            reason = comm.bcast(io.describe(history.error, out) if comm.rank == 0 else None)
+            raise io.OutputError(f"cannot write {at('history.csv')}: {reason}")
+        return state[0], state[1], int(state[2])
+
+    def checkpoint_due(since_checkpoint) -> bool:
         if not stepper.checkpoint_supported:
             return False
         if checkpoint_every:
             return stepper.n % checkpoint_every == 0
-        elapsed = comm.allreduce(time.perf_counter() - last_checkpoint[0], op=MPI.MAX)
-        return bool(checkpoint_seconds) and elapsed > checkpoint_seconds
+        return bool(checkpoint_seconds) and since_checkpoint > checkpoint_seconds
 
     def record(stats, step_time):
         scalars = stepper.scalars()
@@ -124,21 +232,38 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
 
     def write_fields():
         stepper.update_output()
-        xdmf.write(stepper.output_fields, stepper.t)
-        io.write_json(out / "summary.json", summary, comm)
+        io.collective(comm, out, at(f"{xdmf_name} (+ .h5)"), xdmf.write, stepper.output_fields,
+                      stepper.t)
+        write_summary()
+
+    def figure(fig, suffix=""):
+        def draw():
+            summary["outputs"]["figures"].append(draw_figure(ex, fig, stepper, out, suffix))
+        io.collective(comm, out, at(fig.filename), draw)
 
     def timed_figures():
         """Figures requested at the current time (Figure.times)."""
         for fig in ex.figures if figures else []:
             if any(abs(stepper.t - t) < 0.5 * grid.k for t in fig.times):
                 stepper.update_output()
-                summary["outputs"]["figures"].append(
-                    draw_figure(ex, fig, stepper, out, suffix=f"_t{stepper.t:g}"))
+                figure(fig, suffix=f"_t{stepper.t:g}")
+
+    def interrupt(signum):
+        name = signal.Signals(signum).name
+        if stepper.checkpoint_supported:
+            save_checkpoint()
+        summary.update(status="interrupted", signal=name,
+                       wall_time_s=previous_wall + time.perf_counter() - wall_start)
+        write_summary()
+        kept = ("checkpoint written; --restart continues the run" if stepper.checkpoint_supported
+                else f"example {ex.id} has no checkpoints: the history and fields so far stay")
+        raise RunInterrupted(signum, f"stopped by {name} after step {stepper.n} "
+                                     f"(t = {stepper.t:.6g}): {kept}")
 
     try:
         start = time.perf_counter()
         if resume:
-            checkpoint.load(out, stepper.checkpoint_state())
+            checkpoint.load(path, stepper.checkpoint_state())
             stepper.restore(resume["step"])
             stats, scalars = {}, stepper.scalars()
             write_fields()
@@ -152,12 +277,15 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
             start = time.perf_counter()
             stats = stepper.advance()
             scalars = record(stats, time.perf_counter() - start)
+            since_checkpoint, elapsed, signum = end_of_step()
+            if signum and stepper.n < N:
+                interrupt(signum)
             stop = stepper.stop_reason()
-            if time_limit and comm.allreduce(time.perf_counter() - wall_start, op=MPI.MAX) > time_limit:
+            if time_limit and elapsed > time_limit:
                 stop = stop or "time_limit"
             if stop or stepper.n % write_every == 0 or stepper.n == N:
                 write_fields()
-            if (stop and stepper.n < N) or checkpoint_due():
+            if (stop and stepper.n < N) or checkpoint_due(since_checkpoint):
                 save_checkpoint()
             timed_figures()
             report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
@@ -166,45 +294,92 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                 break
         else:
             summary["status"] = "completed"
-    except ConvergenceError as exc:
+        if checkpoints and last_checkpoint["step"] != stepper.n:
+            save_checkpoint()  # so that --restart with a larger T continues from here
+        history.close()
+        stepper.update_output()
+        final = {"u": stepper.u, "zeta": stepper.zeta, "von_mises": stepper.von_mises}
+        final.update({f.name: f for f in stepper.output_fields if f.name not in final})
+        io.collective(comm, out, at("fields_final.npz"), io.save_final_fields,
+                      out / "fields_final.npz", final)
+        if figures:
+            stepper.update_output()
+            for fig in ex.figures:
+                if not fig.times:
+                    figure(fig)
+    except (ConvergenceError, io.OutputError) as exc:
         summary.update(status="failed", error=str(exc),
                        wall_time_s=previous_wall + time.perf_counter() - wall_start)
-        io.write_json(out / "summary.json", summary, comm)
+        if comm.rank == 0:
+            try:  # where space allows
+                io.write_json(out / "summary.json", summary, comm)
+            except OSError:
+                pass
         history.close()
         raise
-    history.close()
-    stepper.update_output()
-    final = {"u": stepper.u, "zeta": stepper.zeta, "von_mises": stepper.von_mises}
-    final.update({f.name: f for f in stepper.output_fields if f.name not in final})
-    io.save_final_fields(out / "fields_final.npz", final)
-    if figures:
-        stepper.update_output()
-        summary["outputs"]["figures"] += [draw_figure(ex, fig, stepper, out)
-                                          for fig in ex.figures if not fig.times]
     summary["timings_s"] = dict(getattr(stepper, "timings", {}))
     summary["wall_time_s"] = previous_wall + time.perf_counter() - wall_start
-    io.write_json(out / "summary.json", summary, comm)
+    write_summary()
     if comm.rank == 0 and progress:
         print(f"[{ex.id}] {summary['status']} at t = {stepper.t:.5g} after {stepper.n} steps in "
               f"{summary['wall_time_s']:.1f} s on {comm.size} rank(s); output in {out}", flush=True)
     return summary
 
 
-def _check_restart(out, settings, grid) -> dict:
-    """The checkpoint metadata in ``out`` after checking it belongs to this run."""
-    meta = checkpoint.read_meta(out)
+def _previous_run(out, comm):
+    """The summary of a run already in ``out`` (with a 'description'), or None."""
+    result = None
+    if comm.rank == 0:
+        try:
+            result = json.loads((out / "summary.json").read_text())
+        except FileNotFoundError:
+            if any((out / name).exists() for name in checkpoint.GENERATIONS):
+                result = {"status": "running", "steps_done": "?"}
+        except (OSError, ValueError):
+            result = {"status": "unreadable", "steps_done": "?"}
+        if result is not None:
+            status = result.get("status")
+            kind = {"running": "an interrupted run", "interrupted": "an interrupted run",
+                    "failed": "a failed run"}.get(status, f"a finished run ({status})")
+            result["description"] = (f"{kind} of {result.get('example', '?')} "
+                                     f"({result.get('steps_done')} steps done)")
+    return comm.bcast(result, root=0)
+
+
+def _remove_run_files(out, comm):
+    if comm.rank == 0:
+        for path in [out / name for name in RUN_FILES] + list(out.glob("fields*.xdmf")) + \
+                list(out.glob("fields*.h5")):
+            if path.exists():
+                path.unlink()
+
+
+def _check_restart(out, settings, grid, previous, comm):
+    """(checkpoint file, its metadata) after checking it belongs to this run, or None when the
+    run in ``out`` finished and this T adds no step (nothing to do)."""
+    finished = previous is not None and previous.get("status") in FINISHED
+    try:
+        path, meta = checkpoint.latest(out, comm)
+    except InputError:
+        if not finished:
+            raise
+        path, meta = None, {key: previous.get(key) for key in ("example", "n", "k")}
     for key, value in settings.items():
-        if meta.get(key) != value:
-            raise InputError(f"cannot restart: the checkpoint in {str(out)!r} has {key} = "
-                             f"{meta.get(key)!r}, this run {value!r}")
+        if key in meta and meta.get(key) != value:
+            raise InputError(f"cannot restart: the {'checkpoint' if path else 'run'} in "
+                             f"{str(out)!r} has {key} = {meta.get(key)!r}, this run {value!r}")
+    if finished and (previous["status"] != "completed" or grid.num_steps <= previous["steps_done"]):
+        return None
+    if path is None:
+        raise InputError(f"cannot continue the completed run in {str(out)!r} to T = {grid.T:g}: "
+                         "it has no checkpoint (checkpoints were off)")
     if meta["step"] > grid.num_steps:
         raise InputError(f"cannot restart: the checkpoint is at t = {meta['t']}, beyond T = {grid.T}")
-    return meta
+    return path, meta
 
 
 def auto_amplification(stepper, diameter) -> float:
     """G40: the factor that makes the largest displacement 10% of the domain diameter."""
-    import numpy as np
     u = stepper.u.x.array.reshape(-1, 2)
     umax = stepper.comm.allreduce(float(np.max(np.linalg.norm(u, axis=1))) if u.size else 0.0,
                                   op=MPI.MAX)
