@@ -2,7 +2,10 @@
 
 Options the parser does not know (``-mech_ksp_type cg``, ``-damage_snes_monitor``) go to the
 PETSc options database. User errors print one line on rank 0 and exit with status 2; a solver
-that does not converge exits with status 3 after writing what was finished.
+that does not converge exits with status 3 after writing what was finished; an output error
+(disk full, I/O error, output folder deleted) exits with status 4; SIGTERM, SIGINT or SIGUSR1
+stop a run at the end of the current step with a checkpoint, exit status 128 + signal number
+(143, 130, 138).
 """
 from __future__ import annotations
 
@@ -46,6 +49,8 @@ def _parser():
                      help="wall-time interval between checkpoints (0: none; default 120)")
     run.add_argument("--restart", action="store_true",
                      help="resume from the checkpoint in --out (any number of MPI ranks)")
+    run.add_argument("--overwrite", action="store_true",
+                     help="replace a run already in --out (without it such a folder is refused)")
 
     conv = sub.add_parser("converge", help="convergence study against a fine reference",
                           allow_abbrev=False)
@@ -101,6 +106,8 @@ def main(argv=None):
     args, extra = _parser().parse_known_args(argv)
     from .parameters import InputError
     from .solvers import ConvergenceError
+    from .io import OutputError
+    from .runner import RunInterrupted
     try:
         leftovers = _petsc_options(extra)
         if leftovers:
@@ -118,7 +125,8 @@ def main(argv=None):
                        mesh_file=args.mesh,
                        write_every=args.write_every, progress=not args.quiet,
                        figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
-                       checkpoint_seconds=args.checkpoint_seconds, restart=args.restart)
+                       checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
+                       overwrite=args.overwrite)
             return 0
         if args.command == "converge":
             from . import convergence
@@ -136,6 +144,14 @@ def main(argv=None):
         if comm.rank == 0:
             print(f"damage-dolfinx: solver failure: {exc}", file=sys.stderr, flush=True)
         return 3
+    except OutputError as exc:
+        if comm.rank == 0:
+            print(f"damage-dolfinx: output error: {exc}", file=sys.stderr, flush=True)
+        return 4
+    except RunInterrupted as exc:
+        if comm.rank == 0:
+            print(f"damage-dolfinx: {exc}", file=sys.stderr, flush=True)
+        return exc.exit_status
     return 1
 
 
