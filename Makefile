@@ -44,9 +44,9 @@ $(VENV)/.installed: pyproject.toml | system-deps
 # Real thesis examples end to end: Section 2.1 Example 2 at the thesis resolution (h = 0.1,
 # k = 0.01; tension-only serially, compression-only on $(NP) ranks) and Example 1 at n = 40.
 demo: setup
-	$(PY) -m damage_dolfinx.cli run 2.1-ex2a --out $(OUT)/demo/2.1-ex2a
-	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex2b --out $(OUT)/demo/2.1-ex2b
-	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex1 --n 40 --k 0.005 --out $(OUT)/demo/2.1-ex1
+	$(PY) -m damage_dolfinx.cli run 2.1-ex2a --overwrite --out $(OUT)/demo/2.1-ex2a
+	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex2b --overwrite --out $(OUT)/demo/2.1-ex2b
+	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.1-ex1 --n 40 --k 0.005 --overwrite --out $(OUT)/demo/2.1-ex1
 	@echo "demo output (XDMF for ParaView, PNG figures, CSV, summary.json) in $(OUT)/demo/"
 
 test: setup
