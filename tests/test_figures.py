@@ -1,0 +1,99 @@
+"""Figure style rules (issue 19): damage colour bars never autoscaled, amplification factors
+round, one stress scale within a thesis pair, and the fidelity comparison of the thesis tables."""
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from damage_dolfinx import examples, figstyle, runner
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def test_amplification_factors_are_round():
+    assert [figstyle.round_amplification(a) for a in (9.70774, 0.119338, 0.0361382, 525.49,
+                                                      16.7, 1.0, 50.0)] == \
+        [5.0, 0.1, 0.02, 500.0, 10.0, 1.0, 50.0]
+    assert not figstyle.is_round(16.7) and figstyle.is_round(200.0) and figstyle.is_round(0.05)
+    assert "shrunk" in figstyle.amplification_text(0.05)
+    assert "×5" in figstyle.amplification_text(5.0)
+    for ex in examples.catalogue().values():  # every fixed factor of the catalogue
+        for fig in ex.figures:
+            if fig.amplification is not None:
+                assert figstyle.is_round(fig.amplification), (ex.id, fig.filename)
+
+
+def _damage_limits(npz):
+    panels, meta, _ = figstyle.load_panels(npz)
+    used = figstyle.render_saved(npz, Path(npz).with_suffix(".again.png"))
+    return [(p, lim) for p, lim in zip(panels, used) if figstyle.is_damage(p["name"], p["label"])]
+
+
+def test_damage_colour_bar_is_fixed_on_a_small_run(tmp_path):
+    """A short 3.2-ex2 run (damage hardly moves from 1): the damage bar still spans
+    [zeta*, 1], read back from the figure's colour limits; its amplification is round."""
+    summary = runner.run("3.2-ex2", tmp_path, n=4, T=0.05, progress=False)
+    figures = {f["file"]: f for f in summary["outputs"]["figures"]}
+    zeta_star = summary["parameters"]["zeta_star"]
+    (panel, limits), = _damage_limits(tmp_path / "figure_3_12.npz")
+    assert np.min(panel["values"]) > 0.5                     # the field is nearly sound ...
+    assert limits == (zeta_star, 1.0)                        # ... the bar is not autoscaled
+    assert figures["figure_3_12.png"]["amplification"] == 5.0  # the factor of its pair 3.11
+    _, meta, _ = figstyle.load_panels(tmp_path / "figure_3_11.npz")
+    assert meta["mesh_only"] and meta["amplification"] == 5.0   # deformed mesh, no colour field
+
+
+def test_damage_below_zeta_star_widens_the_bar_and_says_so(tmp_path):
+    xy = np.array([[[0, 0], [1, 0], [1, 1]], [[0, 0], [1, 1], [0, 1]]], float)
+    panels = [{"xy": xy, "values": np.array([[1.0, 0.5, -0.2], [1.0, -0.2, 0.9]]),
+               "name": "zeta", "label": "damage zeta [-]"},
+              {"xy": xy, "values": np.array([3.0, 7.0]), "name": "von_mises",
+               "label": "von Mises stress [Pa]"}]
+    used = figstyle.render_fields(panels, tmp_path / "f.png", zeta_star=0.01, amplification=16.7)
+    assert used[0] == (-0.2, 1.0) and used[1] == (0.0, 7.0)
+    vmin, vmax, note = figstyle.damage_limits(panels[0]["values"], 0.01)
+    assert "min" in note and "-0.2" in note
+
+
+def test_pair_shares_the_stress_scale(tmp_path):
+    xy = np.array([[[0, 0], [1, 0], [1, 1]]], float)
+    for name, s in (("a", 3.0), ("b", 9.0)):
+        panels = [{"xy": xy, "values": np.array([s]), "name": "von_mises", "label": "von Mises"},
+                  {"xy": xy, "values": np.array([[1.0, 0.9, 0.8]]), "name": "zeta", "label": "zeta"}]
+        figstyle.save_panels(tmp_path / f"{name}.png", panels, title=name, amplification=1.0,
+                             zeta_star=0.01, mesh_only=False)
+    a, b = figstyle.render_pair(tmp_path / "a.npz", tmp_path / "b.npz", tmp_path / "a.png",
+                                tmp_path / "b.png")
+    assert a[0] == b[0] == (0.0, 9.0) and a[1] == b[1] == (0.01, 1.0)
+
+
+def test_fidelity_reads_the_tables_and_our_studies(tmp_path):
+    sys.path.insert(0, str(REPO / "benchmarks"))
+    import fidelity
+    shared = json.loads(fidelity.thesis_tables()[1].read_text())
+    assert shared == json.loads(fidelity.LOCAL_TABLES.read_text())  # the copy is verbatim
+    result = fidelity.compare(tmp_path)  # no results folder: the committed studies
+    tables = {t["table"]: t for t in result["tables"]}
+    assert set(tables) == {"2.4", "2.5", "2.6", "2.7", "3.1", "3.2"}
+    t = tables["2.4"]
+    cell = next(c for c in t["cells"] if c["n"] == 8 and c["k"] == 0.02)
+    assert cell["thesis"] == shared["tables"]["2.4"]["rows"]["8"][0]
+    assert math.isclose(cell["ratio"], cell["ours"] / cell["thesis"])
+    assert t["n_common"] == 25 and t["ratio_min"] <= t["ratio_median"] <= t["ratio_max"]
+    assert all(t["verdict"] for t in tables.values())
+    fidelity.write(result, tmp_path / "fid")
+    assert "| 2.4 |" in (tmp_path / "fid" / "fidelity.md").read_text()
+
+
+@pytest.mark.parametrize("name", ["figure_2_24_25.png", "figure_3_17_18.png"])
+def test_one_file_per_thesis_figure(name):
+    from damage_dolfinx import reproduce
+    variants = {"figure_2_24_25.png": ("2.4-ex1", "tresca", "coulomb"),
+                "figure_3_17_18.png": ("3.3-ex2", "a", "b")}[name]
+    ex, *vs = variants
+    files = {reproduce._figure_name(name, reproduce.Job(ex, v)) for v in vs}
+    assert files == ({"figure_2_24.png", "figure_2_25.png"} if ex == "2.4-ex1"
+                     else {"figure_3_17.png", "figure_3_18.png"})
