@@ -31,6 +31,17 @@ def test_quick_figures_and_report(tmp_path):
     md = (tmp_path / "REPORT.md").read_text()
     assert "damage-dolfinx run 2.3-ex1" in md          # traceable to its command
     assert "G11" in md and "Observed rate" in md        # assumptions and a convergence table
+    text = page.read_text()
+    assert 'id="contents"' in text and 'id="summary"' in text   # TOC and summary table
+    summary = text[text.index('<table class="summary">'):]
+    summary = summary[:summary.index("</table>")]
+    links = re.findall(r'href="#([\w.-]+)"', summary)
+    anchors = set(re.findall(r'id="([\w.-]+)"', text))
+    assert len(links) >= 50 and set(links) <= anchors           # every row links to its anchor
+    toc = re.findall(r'href="#([\w.-]+)"', text[:text.index('id="summary"')])
+    assert toc and set(toc) <= anchors
+    assert re.search(r"\d+ reproduced, \d+ differ, \d+ not comparable", text)
+    assert 'id="fig-2-14"' in text and "thesis lines" in text   # the produced figure, captioned
     if CHROMIUM is None:
         pytest.skip("chromium not installed (make setup installs it)")
     loaded, total = _images_in_chromium(page)
