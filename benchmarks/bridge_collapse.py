@@ -61,10 +61,11 @@ def plot_curve(P, d, summary, path):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     ax.plot(d, P, "o-", ms=3, label="damage model (this run)")
-    for key, style, label in (("damage_model_kN", "--", "thesis, damage model: 90 kN"),
-                              ("contact_model_kN", ":", "thesis, contact model (40 interfaces): 87.14 kN")):
+    for key, style, label, va in (("damage_model_kN", "--", "thesis, damage model: 90 kN", "bottom"),
+                                  ("contact_model_kN", ":",
+                                   "thesis, contact model (40 interfaces): 87.14 kN", "top")):
         ax.axhline(THESIS[key], ls=style, color="0.4", lw=1)
-        ax.text(d[0], THESIS[key], " " + label, va="bottom", fontsize=8, color="0.3")
+        ax.text(d[0], THESIS[key], " " + label, va=va, fontsize=8, color="0.3")
     if summary.get("failure_load_kN") is not None:
         ax.plot(d[-1], P[-1], "r*", ms=12,
                 label=f"collapse: {summary['failure_load_kN']:.4g} kN (step {summary['failure_step']})")
@@ -94,14 +95,21 @@ def plot_section_damage(summary, path):
     hd = summary["hinge_definition"]
     ax.axhline(hd["min_height"], ls=":", color="0.5", lw=1, label="hinge threshold")
     for h in summary["hinges"]:
-        ax.plot(h["angle_deg"], h["section_damage"], "rv", ms=8)
-        ax.annotate(f"{h['angle_deg']:.1f}°\n{h['damaged_face']}", (h["angle_deg"], h["section_damage"]),
+        active = h.get("mechanism", True)
+        ax.plot(h["angle_deg"], h["section_damage"], "v", ms=8, color="r" if active else "0.6",
+                mfc="r" if active else "none")
+        text = (f"{h['angle_deg']:.1f}°\n{h['opening_face']} opens" if active else
+                f"{h['angle_deg']:.1f}°\nnot rotating")
+        ax.annotate(text, (h["angle_deg"], h["section_damage"]),
                     textcoords="offset points", xytext=(0, 8), ha="center", fontsize=7)
     ax.axvline(load_angle, color="tab:green", lw=1, label=f"load (x = {x_load:.3g} m)")
     ax.set_xlabel(f"angle from the left springing [deg] (centre-line radius {rc:.4g} m)")
     ax.set_ylabel("D_j = 1 - mean eta_*(zeta)")
     ax.set_ylim(0, 1.15)
-    ax.set_title(f"2.1-ex3: damage along the ring at collapse, {len(summary['hinges'])} hinges")
+    ax.set_xlim(-16, 196)  # room for the labels of the springing hinges
+    n_mech = summary.get("n_mechanism_hinges", len(summary["hinges"]))
+    ax.set_title(f"2.1-ex3 at collapse: {len(summary['hinges'])} damage peaks, {n_mech} hinges "
+                 "rotating (filled)", fontsize=10)
     ax.legend(loc="upper center", fontsize=7, ncol=3)
     fig.tight_layout()
     fig.savefig(path, dpi=130)
@@ -134,7 +142,9 @@ def write_outputs(out: Path, summary: dict):
         "relative_to_thesis_contact": None if F is None else F / THESIS["contact_model_kN"] - 1,
         "calibrated": {"load_rate_kN_per_s": summary["bridge"]["load_rate_kN_per_s"],
                        "against": "thesis damage-model failure load 90 kN at h = 0.05, k = 0.001"},
-        "n_hinges": summary["n_hinges"], "hinges": summary["hinges"],
+        "damage_bound": summary.get("damage_bound"), "zeta_min": summary.get("zeta_min_run"),
+        "n_hinges": summary["n_hinges"], "n_mechanism_hinges": summary.get("n_mechanism_hinges"),
+        "hinges": summary["hinges"],
         "failed_sections": summary.get("failed_sections"),
         "mesh": summary["mesh"], "h": summary["h"], "k": summary["k"],
         "mpi_size": summary["mpi_size"], "wall_time_s": summary["wall_time_s"],
@@ -143,7 +153,8 @@ def write_outputs(out: Path, summary: dict):
     (out / "bridge_summary.json").write_text(json.dumps(result, indent=2) + "\n")
     scalar_keys = ["status", "failure_load_kN", "load_increment_kN", "failure_step", "failure_time_s",
                    "failure_displacement_mm", "relative_to_thesis_damage",
-                   "relative_to_thesis_contact", "n_hinges", "h", "k", "mpi_size", "wall_time_s"]
+                   "relative_to_thesis_contact", "damage_bound", "zeta_min", "n_hinges",
+                   "n_mechanism_hinges", "h", "k", "mpi_size", "wall_time_s"]
     with open(out / "bridge_summary.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["quantity", "value"])
@@ -153,7 +164,8 @@ def write_outputs(out: Path, summary: dict):
         w.writerow(["thesis_damage_model_kN", THESIS["damage_model_kN"]])
         w.writerow(["thesis_contact_model_kN", THESIS["contact_model_kN"]])
     with open(out / "hinges.csv", "w", newline="") as f:
-        keys = ["section", "angle_deg", "s_m", "x_m", "y_m", "section_damage", "damaged_face"]
+        keys = ["section", "angle_deg", "s_m", "x_m", "y_m", "section_damage", "damaged_face",
+                "rotation_step_mrad", "rotation_step_relative", "mechanism", "opening_face"]
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         w.writeheader()
         w.writerows(summary["hinges"])
@@ -172,11 +184,15 @@ def report(result):
               f"87.14 kN (contact; {100 * rel_c:+.1f}%)")
         print(f"  load_rate {result['calibrated']['load_rate_kN_per_s']:g} kN/s is CALIBRATED against "
               f"the 90 kN: this agreement is by construction")
-    print(f"  {result['n_hinges']} hinges (peaks of the section damage):")
+    print(f"  damage bound {result['damage_bound']}: min zeta over the run {result['zeta_min']:.4g}")
+    print(f"  {result['n_hinges']} hinges (peaks of the section damage), "
+          f"{result['n_mechanism_hinges']} rotating in the collapse step (the mechanism):")
     for h in result["hinges"]:
         print(f"    section {h['section']:4d}  {h['angle_deg']:6.1f} deg from the left springing  "
               f"s = {h['s_m']:6.3f} m  x = {h['x_m']:+.3f} m  D = {h['section_damage']:.2f}  "
-              f"{h['damaged_face']}")
+              f"lower zeta: {h['damaged_face']}; last-step rotation {h['rotation_step_mrad']:+.3f} "
+              f"mrad ({h['rotation_step_relative']:.2f}) "
+              + (f"-> {h['opening_face']} opens" if h["mechanism"] else "-> not in the mechanism"))
 
 
 def main():

@@ -25,7 +25,8 @@ problem (2.96), line 1566, of the other sections, whose bound and reason are lin
 with the Section 2.1 source unchanged; it equals (2.20) wherever the linear step stays in
 [zeta_star, 1]. "clamp" truncates the nodal values of the linear step, zeta_n <- eta_*(zeta_n):
 with the consistent mass matrix it leaves checkerboard oscillations in the damaged zones.
-"none" is the literal linear step (2.20) (its figures are coloured over the data range).
+"none" is the literal linear step (2.20). The damage figures are drawn on [zeta_star, 1]
+(figstyle; a field that leaves it widens the scale and prints its extremes).
 
 Hinges (the mechanism, thesis Figures 2.8-2.9): the sections where damage localises. For every
 section the *section damage* D_j = 1 - mean of eta_*(zeta_n) over its nodes is the average
@@ -34,9 +35,14 @@ the ring (scipy.signal.find_peaks, the ring ends padded with D = 0 so that a spr
 peak) of height >= ``hinge_damage`` (default 0.3) and prominence >= ``hinge_prominence``
 (default 0.2), peaks closer than ``hinge_separation`` (default: one ring thickness) merged. For
 each hinge the face with the lower zeta (intrados or extrados) is reported: with tension-only
-damage that is the face that opens. The thresholds are conventions, not calibrated to a count:
-on the default run the count is 5 for heights 0.2-0.4 with prominences 0.1-0.2, 4 for height
-0.45, 3 for prominence 0.3; compare the positions and the D_j profile, not only the count.
+damage that is the face that opens. The thresholds are conventions, not calibrated to a count.
+
+Mechanism: a peak of D_j marks damage, not motion (self weight alone leaves four symmetric
+peaks). The rotation of each cross-section is measured as the least-squares slope d u_t/d r of
+the tangential displacement across it (``section_rotation``); a hinge's rotation in the collapse
+step is the jump of that slope across +- one hinge separation. A hinge belongs to the mechanism
+if it rotates by at least ``hinge_rotation`` (default 0.2) x the largest hinge rotation; its
+opening face is the extrados if the jump is positive, the intrados otherwise.
 """
 from __future__ import annotations
 
@@ -65,6 +71,8 @@ BRIDGE_DEFAULTS = {
     "hinge_damage": 0.3,     # a hinge is a peak of the section damage D_j of at least this height
     "hinge_prominence": 0.2,  # ... standing out by at least this much (scipy find_peaks)
     "hinge_separation": 0.0,  # merge peaks closer than this [m]; 0 = one ring thickness
+    "hinge_rotation": 0.2,   # a hinge belongs to the mechanism if it rotates in the collapse
+                             # step by at least this fraction of the largest hinge rotation
     "damage_bound": "obstacle",  # keep zeta_n in [zeta_star, 1] (module docstring): "obstacle",
                                  # "clamp", or "none" (the literal linear step (2.20))
 }
@@ -91,7 +99,8 @@ def check_bridge_parameters(extra: dict):
              "load_rate": (lambda v: v >= 0, "(kN/s) must be >= 0"),
              "hinge_damage": (lambda v: 0 < v < 1, "must lie in (0, 1)"),
              "hinge_prominence": (lambda v: 0 <= v < 1, "must lie in [0, 1)"),
-             "hinge_separation": (lambda v: v >= 0, "(m) must be >= 0")}
+             "hinge_separation": (lambda v: v >= 0, "(m) must be >= 0"),
+             "hinge_rotation": (lambda v: 0 <= v <= 1, "must lie in [0, 1]")}
     bound = extra.get("damage_bound", BRIDGE_DEFAULTS["damage_bound"])
     if bound not in DAMAGE_BOUNDS:
         raise InputError(f"damage_bound must be one of {', '.join(DAMAGE_BOUNDS)}, got "
@@ -153,9 +162,6 @@ class BridgeDamage(ElasticDamage):
                                      prefix=prefix)
         elif bound == "clamp":
             self.damage = _ClampedStep(self.damage, p.zeta_star)
-        # colour range of the damage figures: the admissible set [zeta_star, 1]; the literal
-        # step is drawn over its own range so that an undershoot below zeta_star stays visible
-        self.zeta.plot_range = None if bound == "none" else (p.zeta_star, 1.0)
 
     # -- loads (G3)
     def loads(self):
@@ -188,8 +194,16 @@ class BridgeDamage(ElasticDamage):
         keep = geo.in_ring(x) & (j >= 0) & (j <= geo.n_theta)
         self._sec_dofs = np.flatnonzero(keep).astype(np.int32)
         self._sec_j = j[keep]
-        r, _ = geo.polar(x[keep])
+        r, theta = geo.polar(x[keep])
         ns = geo.n_theta + 1
+        # section rotation (``section_rotation``): the vector P1 space has the scalar layout
+        V = self.u.function_space
+        if not np.allclose(V.tabulate_dof_coordinates()[:n_owned], x):
+            raise RuntimeError("vector and scalar P1 dof layouts differ")
+        self._sec_r = r
+        self._sec_tangent = np.stack([np.sin(theta), -np.cos(theta)], axis=1)  # left -> right
+        self._phi_prev, self._phi_n = None, None
+        self._dphi = np.zeros(ns)
         count = np.bincount(self._sec_j, minlength=ns).astype(np.int64)
         self.section_nodes = _allreduce(self.comm, count, MPI.SUM)
         # intrados / extrados node of each section (face of the first damage)
@@ -220,6 +234,19 @@ class BridgeDamage(ElasticDamage):
                 "zeta_intrados": _allreduce(c, z_in, MPI.MIN),
                 "zeta_extrados": _allreduce(c, z_out, MPI.MIN)}
 
+    def section_rotation(self) -> np.ndarray:
+        """Per section j (global): least-squares slope d u_t/d r of the tangential displacement
+        across the section, i.e. minus the rotation of the cross-section [rad]. Its jumps
+        between sections are the hinge rotations of the mechanism."""
+        ns = self.data.geometry.n_theta + 1
+        u = self.u.x.array.reshape(-1, 2)[self._sec_dofs]
+        ut = np.sum(u * self._sec_tangent, axis=1)
+        r, j = self._sec_r, self._sec_j
+        sums = np.stack([np.bincount(j, weights=w, minlength=ns)
+                         for w in (np.ones_like(r), r, ut, r * r, r * ut)])
+        n, sr, su, srr, sru = _allreduce(self.comm, sums, MPI.SUM)
+        return (n * sru - sr * su) / (n * srr - sr * sr)
+
     def hinge_separation(self) -> float:
         geo = self.data.geometry
         return self.bridge["hinge_separation"] or (geo.r_out - geo.r_in)
@@ -237,7 +264,17 @@ class BridgeDamage(ElasticDamage):
         j = peaks - 1
         pts = geo.section_points(j)
         face = np.where(stats["zeta_intrados"][j] < stats["zeta_extrados"][j], "intrados", "extrados")
+        # rotation of each hinge in the last step: jump of the section rotation across +- one
+        # hinge separation, relative to the largest one (which hinges move at collapse)
+        n_last = self._dphi.size - 1
+        rot = np.array([self._dphi[min(jj + distance, n_last)] - self._dphi[max(jj - distance, 0)]
+                        for jj in j])
+        rel = np.abs(rot) / max(np.abs(rot).max(), 1e-300) if rot.size else rot
         return [{"section": int(j[i]), "s_m": round(float(pts["s"][i]), 4),
+                 "rotation_step_mrad": round(1e3 * float(rot[i]), 6),
+                 "rotation_step_relative": round(float(rel[i]), 3),
+                 "mechanism": bool(rel[i] >= self.bridge["hinge_rotation"]),
+                 "opening_face": "extrados" if rot[i] > 0 else "intrados",
                  "angle_deg": round(float(pts["angle_deg"][i]), 3),
                  "x_m": round(float(pts["x"][i]), 4), "y_m": round(float(pts["y"][i]), 4),
                  "section_damage": round(float(D[j[i]]), 4), "zeta_max": float(stats["zeta_max"][j[i]]),
@@ -255,6 +292,10 @@ class BridgeDamage(ElasticDamage):
         collapse (a section with max zeta_n <= zeta_star)."""
         out = super().scalars()
         stats = self.section_stats()
+        if self.n != self._phi_n:  # rotation increment of the last step (once per step)
+            phi = self.section_rotation()
+            self._dphi = phi - (phi if self._phi_prev is None else self._phi_prev)
+            self._phi_prev, self._phi_n = phi, self.n
         weakest = int(np.argmin(stats["zeta_max"]))
         hinges = self.hinges(stats)
         self._hinges = hinges
@@ -294,10 +335,15 @@ class BridgeDamage(ElasticDamage):
             "load_increment_kN": self.bridge["load_rate"] * self.data.time.k,
             "damage_bound": self.bridge["damage_bound"], "zeta_min_run": self.zeta_min_run,
             "hinges": hinges, "n_hinges": len(hinges),
+            "n_mechanism_hinges": sum(h["mechanism"] for h in hinges),
             "hinge_definition": {"section_damage": "D_j = 1 - mean eta_*(zeta) over section j",
                                  "min_height": self.bridge["hinge_damage"],
                                  "min_prominence": self.bridge["hinge_prominence"],
-                                 "min_separation_m": self.hinge_separation()},
+                                 "min_separation_m": self.hinge_separation(),
+                                 "mechanism": "rotation in the collapse step >= "
+                                 f"{self.bridge['hinge_rotation']} x the largest (jump of the "
+                                 "section rotation d u_t/d r across +- one separation); opening "
+                                 "face: extrados if the jump is positive"},
             "bridge": {"load_rate_kN_per_s": self.bridge["load_rate"],
                        "self_weight_N_per_m3": self.bridge["rho"] * self.bridge["gravity"],
                        "x_load_m": geo.x_load, "patch_length_m": self.patch_length,
