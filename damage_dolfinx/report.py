@@ -8,16 +8,20 @@ Sources, each traceable to the command that produced it:
 * friction CPU comparison: ``reference_output/friction_cpu/cpu.md`` and ``friction_cpu_stick/cpu.md``
   (benchmarks/friction_cpu_2_2.py);
 * assumptions: the catalogue (every example's list, with the PROBLEMS.md gap numbers).
-The HTML is produced from the same blocks (no Markdown library needed).
+The document: title block with the verdict counts, TOC, summary table (one row per thesis table
+and figure, thesis order: report_figures.py and benchmarks/fidelity.py), known differences,
+benchmarks/readings.md when present, then every section with its figures (full resolution
+preferred, quick ones marked), thesis-beside-ours tables and assumptions. Rendering: report_doc.py.
 """
 from __future__ import annotations
 
 import html
 import json
-import os
 import re
 import time
 from pathlib import Path
+
+from .report_doc import Doc, _inline
 
 REPO = Path(__file__).resolve().parents[1]
 REFERENCE = REPO / "benchmarks" / "reference_output"
@@ -30,188 +34,6 @@ SECTION_TITLES = {
     "3.2": "Section 3.2: dynamic Kelvin-Voigt contact, bilateral Tresca friction",
     "3.3": "Section 3.3: fully damageable dynamic contact",
 }
-
-
-class Doc:
-    """Blocks rendered both as Markdown and as HTML."""
-
-    def __init__(self, base: Path):
-        self.base, self.blocks = base, []
-
-    def heading(self, level, text):
-        self.blocks.append(("h", level, text))
-
-    def para(self, text):
-        self.blocks.append(("p", text))
-
-    def code(self, text):
-        self.blocks.append(("code", text))
-
-    def image(self, path: Path, caption):
-        self.blocks.append(("img", os.path.relpath(path, self.base), caption))
-
-    def figure(self, paths, caption, anchor):
-        """One thesis figure: its PNG(s) side by side, an anchor and a caption."""
-        self.blocks.append(("fig", [os.path.relpath(p, self.base) for p in paths], caption, anchor))
-
-    def anchor_heading(self, level, text, anchor):
-        self.blocks.append(("ah", level, text, anchor))
-
-    def raw(self, html_text, markdown_text):
-        """Pre-rendered HTML (and its Markdown equivalent)."""
-        self.blocks.append(("raw", html_text, markdown_text))
-
-    def note(self, text):
-        """Small print under a table (column explanations)."""
-        self.blocks.append(("note", text))
-
-    def items(self, lines):
-        self.blocks.append(("ul", list(lines)))
-
-    def markdown_table(self, text):
-        """Copy a Markdown file's content (tables and paragraphs)."""
-        self.blocks.append(("md", text))
-
-    # -- rendering
-    def to_markdown(self) -> str:
-        out = []
-        for b in self.blocks:
-            if b[0] == "h":
-                out.append("#" * b[1] + " " + b[2])
-            elif b[0] == "p":
-                out.append(b[1])
-            elif b[0] == "code":
-                out.append("```\n" + b[1] + "\n```")
-            elif b[0] == "img":
-                out.append(f"![{b[2]}]({b[1]})\n\n*{b[2]}*")
-            elif b[0] == "ul":
-                out.append("\n".join(f"- {line}" for line in b[1]))
-            elif b[0] == "md":
-                out.append(_demote_headings(b[1]))
-            elif b[0] == "fig":
-                out.append("".join(f"![{b[3]}]({p}) " for p in b[1]) + f"\n\n*{b[2]}*")
-            elif b[0] == "ah":
-                out.append(f'<a id="{b[3]}"></a>\n\n' + "#" * b[1] + " " + b[2])
-            elif b[0] == "raw":
-                out.append(b[2])
-            elif b[0] == "note":
-                out.append(f"*{b[1]}*")
-        return "\n\n".join(out) + "\n"
-
-    def to_html(self, title) -> str:
-        body = []
-        for b in self.blocks:
-            if b[0] == "h":
-                body.append(f"<h{b[1]}>{_inline(b[2])}</h{b[1]}>")
-            elif b[0] == "p":
-                body.append(f"<p>{_inline(b[1])}</p>")
-            elif b[0] == "code":
-                body.append(f"<pre><code>{html.escape(b[1])}</code></pre>")
-            elif b[0] == "img":
-                body.append(f'<figure><img src="{html.escape(b[1])}" alt="{html.escape(b[2])}">'
-                            f"<figcaption>{_inline(b[2])}</figcaption></figure>")
-            elif b[0] == "ul":
-                body.append("<ul>" + "".join(f"<li>{_inline(x)}</li>" for x in b[1]) + "</ul>")
-            elif b[0] == "md":
-                body.append(_markdown_to_html(_demote_headings(b[1])))
-            elif b[0] == "fig":
-                imgs = "".join(f'<img src="{html.escape(p)}" alt="{html.escape(b[3])}">'
-                               for p in b[1])
-                body.append(f'<figure id="{b[3]}" class="n{min(len(b[1]), 2)}">{imgs}'
-                            f"<figcaption>{_inline(b[2])}</figcaption></figure>")
-            elif b[0] == "ah":
-                body.append(f'<h{b[1]} id="{b[3]}">{_inline(b[2])}</h{b[1]}>')
-            elif b[0] == "raw":
-                body.append(b[1])
-            elif b[0] == "note":
-                body.append(f'<p class="note">{_inline(b[1])}</p>')
-        return HTML_TEMPLATE.format(title=html.escape(title), body="\n".join(body))
-
-
-def _inline(text) -> str:
-    text = html.escape(text)
-    text = re.sub(r"`([^`]+)`", r"<code>\1</code>", text)
-    text = re.sub(r"\[([^]]+)\]\(#([\w-]+)\)", r'<a href="#\2">\1</a>', text)
-    text = re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", text)
-    return re.sub(r"(?<![\w*])\*([^*]+)\*(?![\w*])", r"<i>\1</i>", text)
-
-
-def _demote_headings(text) -> str:
-    return re.sub(r"^(#+) ", lambda m: "#" * min(6, len(m.group(1)) + 3) + " ", text, flags=re.M)
-
-
-def _markdown_to_html(text) -> str:
-    """Headings, pipe tables and paragraphs (the subset our tables use)."""
-    out, lines, i = [], text.splitlines(), 0
-    while i < len(lines):
-        line = lines[i]
-        if line.startswith("|"):
-            rows = []
-            while i < len(lines) and lines[i].startswith("|"):
-                cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
-                if not all(set(c) <= set("-: ") for c in cells):
-                    rows.append(cells)
-                i += 1
-            head, *rest = rows
-            out.append("<table><tr>" + "".join(f"<th>{_inline(c)}</th>" for c in head) + "</tr>"
-                       + "".join("<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in r) + "</tr>"
-                                 for r in rest) + "</table>")
-            continue
-        m = re.match(r"^(#+) (.*)", line)
-        if m:
-            out.append(f"<h{len(m.group(1))}>{_inline(m.group(2))}</h{len(m.group(1))}>")
-        elif line.strip():
-            out.append(f"<p>{_inline(line)}</p>")
-        i += 1
-    return "\n".join(out)
-
-
-HTML_TEMPLATE = """<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>{title}</title>
-<style>
-body {{ font-family: "DejaVu Sans", sans-serif; max-width: 62em; margin: 2em auto;
-        line-height: 1.4; font-size: 11pt; padding: 0 1em; }}
-header.title {{ border-bottom: 2px solid #333; margin-bottom: 1em; }}
-header.title h1 {{ margin-bottom: 0.2em; }}
-img {{ max-width: 100%; }}
-figure {{ margin: 1em 0; break-inside: avoid; }}
-figure.n2 img {{ max-width: 49%; vertical-align: top; }}
-figcaption {{ color: #333; font-size: 90%; margin-top: 0.3em; }}
-table {{ border-collapse: collapse; margin: 0.6em 0; font-size: 85%; break-inside: auto; }}
-tr {{ break-inside: avoid; }}
-td, th {{ border: 1px solid #bbb; padding: 0.15em 0.4em; text-align: right; vertical-align: top; }}
-td.l, th.l {{ text-align: left; }}
-table.summary td {{ text-align: left; }}
-.v-reproduced {{ color: #1a7f37; font-weight: bold; }}
-.v-differs {{ color: #b3261e; font-weight: bold; }}
-.v-not {{ color: #666; font-weight: bold; }}
-td.ratio small {{ color: #555; display: block; font-size: 80%; }}
-td.good {{ background: #e6f4ea; }} td.bad {{ background: #fce8e6; }}
-p.note {{ font-size: 85%; color: #444; margin-top: -0.3em; }}
-nav.toc ol {{ columns: 2; font-size: 92%; }}
-pre {{ background: #f4f4f4; padding: 0.5em; overflow-x: auto; white-space: pre-wrap; }}
-ul.assumptions {{ font-size: 82%; color: #333; }}
-h2 {{ border-bottom: 1px solid #999; break-after: avoid; }} h3, h4 {{ break-after: avoid; }}
-@page {{ size: A4; margin: 14mm 12mm; }}
-@media print {{ body {{ max-width: none; margin: 0; font-size: 9.5pt; }}
-  h2 {{ break-before: page; }} h2.first {{ break-before: auto; }} }}
-</style>
-<script>
-// marks every image as loaded or broken (checked by the test suite in headless Chromium)
-window.addEventListener("load", function () {{
-  var imgs = document.images, ok = 0;
-  for (var i = 0; i < imgs.length; i++) {{
-    var good = imgs[i].complete && imgs[i].naturalWidth > 0;
-    imgs[i].setAttribute("data-loaded", good ? "yes" : "no");
-    if (good) ok++;
-  }}
-  document.body.setAttribute("data-images", ok + "/" + imgs.length);
-}});
-</script></head>
-<body>
-{body}
-</body></html>
-"""
 
 
 def _load_json(path: Path):
