@@ -21,11 +21,15 @@ parser.add_argument("--quick", action="store_true")
 parser.add_argument("--out", default=None)
 parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="model parameter override, e.g. --set friction_law=coulomb (2.4-ex1 P2)")
+parser.add_argument("--reading", choices=("literal", "evidence"),
+                    help="thesis data literally or the evidence reading (issue 16)")
 args = parser.parse_args()
 overrides = dict(pair.split("=", 1) for pair in args.set)
+if args.reading:
+    overrides["reading"] = args.reading
 out = args.out or f"results/convergence/{args.id}" + ("-quick" if args.quick else "")
 if args.quick:
-    study = examples.get(args.id).convergence
+    study = examples.get(args.id, args.reading).convergence
     ns, ks = sorted(study["n"])[:3], sorted(study["k"], reverse=True)[:3]
     s = convergence.study(args.id, out, ref_n=4 * ns[1], ref_k=ks[-1] / 2, ns=ns, ks=ks,
                           overrides=overrides)

@@ -33,6 +33,9 @@ def _parser():
         sp.add_argument("--friction-law", choices=("tresca", "coulomb"),
                         help="Section 2.4: Tresca (P1) or simplified Coulomb (P2) "
                              "(same as --set friction_law=...)")
+        sp.add_argument("--reading", choices=("literal", "evidence"),
+                        help="thesis data read literally or as the evidence reading (issue 16; "
+                             "default: the example's default_reading, see `list`)")
 
     run = sub.add_parser("run", help="run one example", allow_abbrev=False)
     common(run)
@@ -88,11 +91,13 @@ def _is_option(tok):
         return True
 
 
-def _overrides(pairs, friction_solver=None, friction_law=None):
+def _overrides(pairs, friction_solver=None, friction_law=None, reading=None):
     from .parameters import InputError
     out = {} if friction_solver is None else {"friction_solver": friction_solver}
     if friction_law is not None:
         out["friction_law"] = friction_law
+    if reading is not None:
+        out["reading"] = reading
     for pair in pairs:
         if "=" not in pair:
             raise InputError(f"--set expects NAME=VALUE, got {pair!r}")
@@ -116,12 +121,14 @@ def main(argv=None):
             from . import examples
             if comm.rank == 0:
                 for ex in examples.catalogue().values():
-                    print(f"{ex.id:10s} [Section {ex.section}] {ex.title}")
+                    reading = f" (reading: {ex.reading})" if ex.readings else ""
+                    print(f"{ex.id:10s} [Section {ex.section}] {ex.title}{reading}")
             return 0
         if args.command == "run":
             from . import runner
             runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
-                       overrides=_overrides(args.set, args.friction_solver, args.friction_law),
+                       overrides=_overrides(args.set, args.friction_solver, args.friction_law,
+                                                 args.reading),
                        mesh_file=args.mesh,
                        write_every=args.write_every, progress=not args.quiet,
                        figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
@@ -133,7 +140,7 @@ def main(argv=None):
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
                               ns=args.n, ks=args.k, T=args.T,
                               overrides=_overrides(args.set, args.friction_solver,
-                                                   args.friction_law),
+                                                   args.friction_law, args.reading),
                               progress=not args.quiet)
             return 0
     except InputError as exc:

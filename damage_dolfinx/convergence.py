@@ -78,7 +78,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
           progress=True, comm=MPI.COMM_WORLD) -> dict:
     """Run the study; returns the summary (errors per (n, k), fitted rates, wall times)."""
     wall_start = time.perf_counter()
-    ex = examples.get(example_id)
+    ex = examples.get(example_id, (overrides or {}).get("reading"))
     defaults = ex.convergence
     if defaults is None or ex.n is None:
         raise InputError(f"example {example_id} has no nested structured meshes; "
@@ -127,7 +127,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     rates = fitted_rates(rows, ns, ks)
     rates_T = fitted_rates(rows, ns, ks, key="error_at_T")
     summary = {"schema": "damage-dolfinx/convergence/v1", "example": ex.id, "title": ex.title,
-               "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
+               "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
                "error_definition": definition,
                "errors": rows, "rates": rates, "rates_at_T": rates_T, "mpi_size": comm.size,
                "reference": {"wall_time_s": ref_wall, "mesh": ref.mesh_info(),

@@ -103,8 +103,11 @@ EXTRA_RULES = {
                         "(explicit-term time-step check, PROBLEMS.md 1.8) must be warn, error or off"),
     "damage_active": (lambda v: isinstance(v, bool),
                       "(False: damage frozen at zeta_0, Section 3.1 Ex. 3) must be true or false"),
-    "error_norm": (lambda v: v in ("velocity", "displacement"),
-                   "(convergence error of Section 3.1, G27) must be velocity or displacement"),
+    "error_norm": (lambda v: v in ("velocity", "displacement", "velocity_only"),
+                   "(convergence error of Section 3.1, G27) must be velocity, displacement or "
+                   "velocity_only"),
+    "stress_in_error": (lambda v: v in ("yes", "no"),
+                        "(Section 2.4: ||sigma - sigma_hk||_Q in e_hk) must be yes or no"),
     "elastic_term": (lambda v: v in ("explicit", "implicit"),
                      "(Section 3.3: explicit = thesis scheme, implicit = G33 deviation) must be "
                      "'explicit' or 'implicit'"),
@@ -112,6 +115,10 @@ EXTRA_RULES = {
                        "(Section 3.3 Ex. 2: a = centre [2.5,3.5]^2, b = bottom [2.5,3.5]x[0,1]) "
                        "must be 'a' or 'b'"),
 }
+
+
+#: parameters for which inf is meaningful ("no truncation"); every other number must be finite
+INFINITE_ALLOWED = frozenset({"L_trunc"})
 
 
 def _coerce(old, value, key):

@@ -75,14 +75,19 @@ def _quick_options(ex) -> list:
     return extra
 
 
-def figure_jobs(mode: str) -> list:
+def _reading_options(reading) -> list:
+    """``--reading NAME`` (issue 16), or nothing for each example's default reading."""
+    return ["--reading", reading] if reading else []
+
+
+def figure_jobs(mode: str, reading=None) -> list:
     """One Job per (example, variant) of the catalogue."""
     from . import examples
     jobs = []
     for ex in examples.catalogue().values():
         if ex.id in SKIP_RUN or not ex.figures:
             continue
-        base = _quick_options(ex) if mode == "quick" else []
+        base = (_quick_options(ex) if mode == "quick" else []) + _reading_options(reading)
         for variant, sets in (VARIANTS.get(ex.id) or {"": {}}).items():
             options = list(base)
             for key, value in sets.items():
@@ -91,7 +96,7 @@ def figure_jobs(mode: str) -> list:
     return jobs
 
 
-def convergence_jobs(mode: str) -> list:
+def convergence_jobs(mode: str, reading=None) -> list:
     """One Job per convergence study (variants of 2.4-ex1: both friction laws)."""
     from . import examples
     jobs = []
@@ -106,6 +111,7 @@ def convergence_jobs(mode: str) -> list:
                     "--n", *map(str, ns), "--k", *(f"{k:g}" for k in ks)]
         else:
             base = []
+        base += _reading_options(reading)
         for variant, sets in (VARIANTS.get(ex.id) or {"": {}}).items():
             options = list(base)
             for key, value in sets.items():
@@ -169,7 +175,7 @@ def _finish(index: dict, key: str, start: float):
     index["wall_time_s"] = round(sum(e["wall_time_s"] for e in index[key]), 1)
 
 
-def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False) -> dict:
+def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, reading=None) -> dict:
     """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``. With
     ``resume``, jobs that completed in an earlier invocation (same mode) are kept, not rerun."""
     out.mkdir(parents=True, exist_ok=True)
@@ -178,7 +184,7 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False) -> 
     old_figures = json.loads((out / "index.json").read_text())["figures"] if done else []
     index = {"mode": mode, "mpi_size": np_, "runs": [], "figures": []}
     start = time.perf_counter()
-    for job in figure_jobs(mode):
+    for job in figure_jobs(mode, reading):
         if only and job.example not in only:
             continue
         if job.name in done:
@@ -256,14 +262,15 @@ def _bridge_force_displacement(mode, out, np_, index):
                                  "command": command})
 
 
-def run_convergence(mode: str, out: Path, np_: int = 2, only=None, resume=False) -> dict:
+def run_convergence(mode: str, out: Path, np_: int = 2, only=None, resume=False,
+                    reading=None) -> dict:
     """Run every convergence study into ``out/<id>[-variant]`` and write ``out/index.json``.
     With ``resume``, studies that completed in an earlier invocation (same mode) are kept."""
     out.mkdir(parents=True, exist_ok=True)
     done = _previous_entries(out, "studies", mode) if resume else {}
-    index = {"mode": mode, "mpi_size": np_, "studies": []}
+    index = {"mode": mode, "mpi_size": np_, "reading": reading or "default", "studies": []}
     start = time.perf_counter()
-    for job in convergence_jobs(mode):
+    for job in convergence_jobs(mode, reading):
         if only and job.example not in only:
             continue
         if job.name in done:

@@ -113,7 +113,7 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     ``overwrite`` (the command line passes overwrite=False unless --overwrite); a folder where a
     run is live is always refused (io.RunLock). Output errors raise io.OutputError, signals
     RunInterrupted, both after recording the status in summary.json."""
-    ex = examples.get(example_id)
+    ex = examples.get(example_id, (overrides or {}).get("reading"))
     configured = ex.configure(n, k, T, h, overrides, mesh_file)
     if restart and not Path(out).is_dir():
         raise InputError(f"cannot restart: no checkpoint in {str(out)!r} (no such folder)")

@@ -15,7 +15,8 @@ def _params(g_fric, law="tresca"):
         E=1000.0, nu=0.3, kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.1,
         lam_u=1000.0, lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False,
         extra={"friction_law": law, "g_fric": g_fric, "mu_f": 0.05, "S_n": 10.0,
-               "coulomb_normal": "free", "viscoplastic_sign": 1.0, "eps_reg": 1e-9,
+               "coulomb_normal": "free", "viscoplastic_sign": 1.0, "stress_in_error": "yes",
+               "eps_reg": 1e-9,
                "friction_solver": "newton", "rho_uzawa": RHO_UZAWA, "omega_pd": OMEGA_PD,
                "friction_tol": 1e-6})
 

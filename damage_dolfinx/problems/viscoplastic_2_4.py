@@ -85,6 +85,8 @@ class ElastoViscoplasticFriction(TimeStepper):
         self.output_fields = [self.u, self.zeta, self.von_mises, self.sigma]
         self.error_components = [("u", self.u, "V"), ("sigma", self.sigma, "L2"),
                                  ("zeta", self.zeta, "L2")]  # e_hk of Section 2.4.3
+        if x.get("stress_in_error", "yes") == "no":  # issue 16: e_hk without ||sigma||_Q
+            self.error_components = [c for c in self.error_components if c[0] != "sigma"]
         self.timings = {"damage": 0.0, "friction": 0.0, "stress": 0.0}
 
     @staticmethod

@@ -1,0 +1,54 @@
+"""Readings of the thesis data (issue 16): literal = stated data, evidence = documented departures.
+
+Catalogue-level checks (no solve): every departure is an R-entry of the assumptions with thesis
+line numbers, the literal reading is the catalogue entry itself, and the reading is selectable
+from the command line and through --set reading=..., with bad names refused (exit 2).
+"""
+import re
+
+import pytest
+
+from damage_dolfinx import cli, examples
+
+
+def test_literal_is_the_stated_data_and_evidence_departs_with_reasons():
+    for ex_id, ex in examples.catalogue().items():
+        literal = examples.get(ex_id, "literal")
+        evidence = examples.get(ex_id, "evidence")
+        assert literal.reading == "literal" and evidence.reading == "evidence"
+        assert not any(a.startswith("R") for a in literal.assumptions), ex_id
+        departures = [a for a in evidence.assumptions if re.match(r"R\d+ ", a)]
+        if ex.readings.get("evidence") is None:
+            assert evidence.params == literal.params and not departures, ex_id
+            continue
+        assert departures, ex_id
+        for entry in departures:
+            assert re.search(r"line[s]? \d{3,4}", entry), entry  # thesis lines cited
+        assert ex.reading == ex.default_reading
+
+
+def test_reading_changes_only_what_it_lists():
+    for ex_id, ex in examples.catalogue().items():
+        reading = ex.readings.get("evidence")
+        if reading is None:
+            continue
+        lit, ev = examples.get(ex_id, "literal"), examples.get(ex_id, "evidence")
+        changed = {k for k, v in ev.params.as_dict().items() if lit.params.as_dict()[k] != v}
+        assert changed == set(reading.overrides), ex_id
+        assert (ev.traction is lit.traction) == (reading.traction is None), ex_id
+        assert (ev.body_force is lit.body_force) == (reading.body_force is None), ex_id
+
+
+def test_reading_through_overrides_is_the_same_as_get():
+    ex = examples.catalogue()["2.2-ex2"]
+    params, *_ = ex.configure(overrides={"reading": "literal", "kappa": "0.5"})
+    assert params.kappa == 0.5
+    assert examples.get("2.2-ex2", "literal").traction is not examples.get("2.2-ex2").traction
+
+
+@pytest.mark.parametrize("args", [["run", "2.2-ex2", "--set", "reading=bogus"],
+                                  ["converge", "2.2-ex2", "--set", "reading=bogus"]])
+def test_unknown_reading_is_refused(tmp_path, capsys, args):
+    assert cli.main(args + ["--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "unknown reading 'bogus'" in err and err.count("\n") == 1
