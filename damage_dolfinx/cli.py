@@ -10,6 +10,7 @@ stop a run at the end of the current step with a checkpoint, exit status 128 + s
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from mpi4py import MPI
@@ -106,6 +107,16 @@ def _overrides(pairs, friction_solver=None, friction_law=None, reading=None):
     return out
 
 
+def _check_finite(args):
+    """Every number on the command line is finite (argparse's float() accepts 'inf' and 'nan')."""
+    import math
+    from .parameters import InputError
+    for name, value in vars(args).items():
+        for v in value if isinstance(value, list) else [value]:
+            if isinstance(v, float) and not math.isfinite(v):
+                raise InputError(f"--{name.replace('_', '-')} must be a finite number, got {v}")
+
+
 def main(argv=None):
     comm = MPI.COMM_WORLD
     args, extra = _parser().parse_known_args(argv)
@@ -117,6 +128,7 @@ def main(argv=None):
         leftovers = _petsc_options(extra)
         if leftovers:
             raise InputError(f"unrecognised arguments: {' '.join(leftovers)}")
+        _check_finite(args)
         if args.command == "list":
             from . import examples
             if comm.rank == 0:
@@ -154,6 +166,11 @@ def main(argv=None):
     except OutputError as exc:
         if comm.rank == 0:
             print(f"damage-dolfinx: output error: {exc}", file=sys.stderr, flush=True)
+        from .io import FAILED_HDF5_FILES
+        if FAILED_HDF5_FILES:  # HDF5 would crash shutting down the failed file
+            sys.stdout.flush()
+            comm.Barrier()
+            os._exit(4)
         return 4
     except RunInterrupted as exc:
         if comm.rank == 0:

@@ -45,6 +45,23 @@ def function_space(msh, family: str, degree: int, shape: tuple = ()):
     return fem.FunctionSpace(msh, ufl.TensorElement(family, cell, degree, shape=shape))
 
 
+def element_degree(V) -> int:
+    """Polynomial degree of V's element (a method of the legacy UFL element, a property of
+    basix.ufl elements from 0.7 on)."""
+    d = V.ufl_element().degree
+    return int(d() if callable(d) else d)
+
+
+def is_discontinuous(V) -> bool:
+    """True for DG spaces (legacy UFL: family 'Discontinuous Lagrange'; basix.ufl: a flag)."""
+    e = V.ufl_element()
+    flag = getattr(e, "discontinuous", None)
+    if isinstance(flag, bool):
+        return flag
+    family = e.family() if callable(getattr(e, "family", None)) else str(getattr(e, "family_name", ""))
+    return "Discontinuous" in family or family in ("DG", "DP")
+
+
 def scalar_p1(msh):
     return function_space(msh, "Lagrange", 1)
 
@@ -88,20 +105,35 @@ def assemble_matrix(A, a_form, bcs):
 
 def apply_lifting(b, a_form, bcs, x0=None, scale=1.0):
     """b -= scale * A (g - x0) on the columns of Dirichlet dofs ('scale' <= 0.8, 'alpha' >= 0.9)."""
-    fem.petsc.apply_lifting(b, [a_form], [bcs], [] if x0 is None else [x0], scale)
+    x0s = [] if x0 is None else [x0]
+    try:
+        fem.petsc.apply_lifting(b, [a_form], bcs=[bcs], x0=x0s, alpha=scale)
+    except TypeError:  # 0.5-0.8: positional 'scale'
+        fem.petsc.apply_lifting(b, [a_form], [bcs], x0s, scale)
 
 
 def set_bc(b, bcs, x0=None, scale=1.0):
-    fem.petsc.set_bc(b, bcs, x0, scale)
+    try:
+        fem.petsc.set_bc(b, bcs, x0=x0, alpha=scale)
+    except TypeError:  # 0.5-0.8: 'scale'
+        fem.petsc.set_bc(b, bcs, x0, scale)
+
+
+_FORM_OPTIONS_KEY = "jit_options" if "jit_options" in fem.form.__code__.co_varnames else "jit_params"
+_FORM_TYPES = tuple(t for t in (getattr(fem, "FormMetaClass", None), getattr(fem, "Form", None))
+                    if isinstance(t, type))
 
 
 def form(ufl_form, jit_options=None):
-    return fem.form(ufl_form, jit_params=jit_options or {}) if jit_options else fem.form(ufl_form)
+    """Compiled form; JIT options are 'jit_params' up to 0.5, 'jit_options' from 0.6 on."""
+    if not jit_options:
+        return fem.form(ufl_form)
+    return fem.form(ufl_form, **{_FORM_OPTIONS_KEY: jit_options})
 
 
 def assemble_scalar(ufl_or_form, comm) -> float:
     """Globally summed integral of a scalar form (compiled or UFL)."""
-    f = ufl_or_form if isinstance(ufl_or_form, fem.FormMetaClass) else fem.form(ufl_or_form)
+    f = ufl_or_form if isinstance(ufl_or_form, _FORM_TYPES) else fem.form(ufl_or_form)
     return comm.allreduce(fem.assemble_scalar(f), op=_mpi_sum())
 
 

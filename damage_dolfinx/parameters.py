@@ -133,10 +133,16 @@ def _coerce(old, value, key):
                 return False
             raise ValueError
         if isinstance(old, (int, float)) and not isinstance(old, bool):
-            return float(value)
+            number = float(value)
+        else:
+            return value
     except ValueError:
         raise InputError(f"parameter {key}: cannot read {value!r} as {type(old).__name__}") from None
-    return value
+    if math.isnan(number) or (math.isinf(number) and key not in INFINITE_ALLOWED):
+        allowed = (" (inf is allowed only for " + ", ".join(sorted(INFINITE_ALLOWED)) + ")"
+                   if math.isinf(number) else "")
+        raise InputError(f"parameter {key} must be a finite number, got {value!r}{allowed}")
+    return number
 
 
 @dataclass(frozen=True)

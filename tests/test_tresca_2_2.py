@@ -190,6 +190,7 @@ def test_primal_dual_active_set_from_a_reversed_start():
     simple-shear block to the primal Newton's accuracy."""
     from damage_dolfinx.friction import ContactNodes, AlgebraicResidual, PrimalDualActiveSet
     from dolfinx import fem
+    from damage_dolfinx import compat
     mu, lam, g, eps = 2.0, 1.0, 3.0, 1e-9
     for name, load, v_b, shear in [("stick", dict(side_shear=1.0, top_shear=1.0), eps / g, 1.0),
                                    ("slip", dict(side_shear=g, top_velocity=2.5), 1.0, g)]:
@@ -199,7 +200,7 @@ def test_primal_dual_active_set_from_a_reversed_start():
         pdas = PrimalDualActiveSet(residual, f"test_pdas_{name}_")
         assert pdas.usable
         problem.v.x.array.reshape(-1, 2)[:, 0] = -1.0
-        x = problem.v.vector
+        x = compat.petsc_vec(problem.v)
         its = pdas.solve(x, eps, rtol=1e-12, atol=1e-13, max_it=50)
         print(name, its, "iterations")
         problem.v.x.scatter_forward()
