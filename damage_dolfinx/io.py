@@ -9,8 +9,11 @@ rank raises OutputError on every rank (``collective``), so ranks never wait for 
 """
 from __future__ import annotations
 
+import contextlib
 import csv
+import ctypes
 import errno
+import io as _io
 import fcntl
 import json
 import os
@@ -139,7 +142,6 @@ class CSVHistory:
             kept = self.read_rows(path, keep_until_step) if keep_until_step is not None else []
 
             def write(f):
-                import io as _io
                 text = _io.TextIOWrapper(f, newline="", encoding="utf-8")
                 writer = csv.DictWriter(text, fieldnames=self.columns)
                 writer.writeheader()
@@ -181,17 +183,59 @@ class CSVHistory:
 
 
 class XDMFSeries:
-    """XDMF/HDF5 time series of several fields on one mesh, for ParaView."""
+    """XDMF/HDF5 time series of several fields on one mesh, for ParaView. A failed write (full
+    disk) raises RuntimeError with one line: HDF5's own error stack is held back (shown only if
+    the write succeeds anyway), and the file object whose close failed is never destroyed
+    (DOLFINx 0.5 crashes closing it a second time)."""
 
     def __init__(self, path, msh):
         self.path, self.comm = Path(path), msh.comm
-        with compat.xdmf_file(self.comm, self.path, "w") as f:
-            f.write_mesh(msh)
+        f = compat.xdmf_file(self.comm, self.path, "w")
+        with _failed_files_kept(f), _stderr_held_back():
+            with f:
+                f.write_mesh(msh)
 
     def write(self, functions, t: float):
-        with compat.xdmf_file(self.comm, self.path, "a") as f:
-            for fn in functions:
-                f.write_function(fn, t)
+        f = compat.xdmf_file(self.comm, self.path, "a")
+        with _failed_files_kept(f), _stderr_held_back():
+            with f:
+                for fn in functions:
+                    f.write_function(fn, t)
+
+
+#: XDMF files whose close failed: DOLFINx 0.5 / HDF5 crash (SIGSEGV) when such a file is
+#: destroyed or when HDF5 shuts down, so they are kept alive and the command line ends the
+#: process with os._exit (cli.py) when this list is not empty
+FAILED_HDF5_FILES = []
+
+
+@contextlib.contextmanager
+def _failed_files_kept(f):
+    try:
+        yield
+    except RuntimeError:
+        FAILED_HDF5_FILES.append(f)
+        ctypes.pythonapi.Py_IncRef(ctypes.py_object(f))  # never destroyed: no second close
+        raise
+
+
+@contextlib.contextmanager
+def _stderr_held_back():
+    """File descriptor 2 goes to a memory file; replayed unless an exception is raised."""
+    sys.stderr.flush()
+    saved, memory = os.dup(2), os.memfd_create("held-back-stderr")
+    os.dup2(memory, 2)
+    failed = True
+    try:
+        yield
+        failed = False
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        if not failed and os.lseek(memory, 0, os.SEEK_END):
+            os.lseek(memory, 0, os.SEEK_SET)
+            sys.stderr.write(os.read(memory, 1 << 20).decode(errors="replace"))
+        os.close(memory)
 
 
 def gather_dof_field(u):
@@ -221,14 +265,27 @@ def save_final_fields(path, functions: dict):
         if gathered is not None:
             data[name + "_coords"], data[name] = gathered
     if data:
-        atomic_write_bytes(path, lambda f: np.savez(f, **data))
+        atomic_write_bytes(path, npz_writer(data))
+
+
+def npz_writer(arrays: dict):
+    """A ``write(fileobj)`` for atomic_write_bytes: the NPZ is built in memory, so a failed
+    write leaves no half-closed zip object behind (no 'Exception ignored' noise)."""
+    def write(f):
+        buffer = _io.BytesIO()
+        np.savez(buffer, **arrays)
+        f.write(buffer.getbuffer())
+    return write
 
 
 class RunLock:
     """``out/.lock``, held (flock) by rank 0 of the live run; the kernel drops it when that
     process dies, even by SIGKILL, so a dead run never blocks a new one. Raises InputError when
     a live run holds it. Where the file system has no flock, a lock whose process is gone (same
-    host) is taken over."""
+    host) is taken over. The file also reserves RESERVE bytes of disk that ``free_reserve``
+    gives back, so that a run stopped by a full disk can still record it in summary.json."""
+
+    RESERVE = 1 << 16
 
     def __init__(self, out, comm=MPI.COMM_WORLD):
         self.path, self.comm, self._fd = Path(out) / ".lock", comm, None
@@ -243,7 +300,7 @@ class RunLock:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
-                holder = os.read(fd, 1000).decode(errors="replace").strip()
+                holder = os.read(fd, 1000).decode(errors="replace").split("\n")[0]
                 os.close(fd)
                 return f"a run is live in {str(self.path.parent)!r} ({holder or 'see .lock'}); " \
                        f"wait for it to end or stop it (a dead run's lock is released at once)"
@@ -258,12 +315,21 @@ class RunLock:
                 same = False
             if same:
                 os.ftruncate(fd, 0)
-                os.pwrite(fd, f"pid {os.getpid()} host {socket.gethostname()} since "
-                              f"{time.strftime('%Y-%m-%dT%H:%M:%S')}\n".encode(), 0)
+                self._header = (f"pid {os.getpid()} host {socket.gethostname()} since "
+                                f"{time.strftime('%Y-%m-%dT%H:%M:%S')}\n").encode()
+                try:
+                    os.pwrite(fd, self._header + b" " * self.RESERVE, 0)
+                except OSError:  # a nearly full disk: no reserve
+                    os.ftruncate(fd, 0)
+                    os.pwrite(fd, self._header, 0)
                 self._fd = fd
                 return None
             os.close(fd)
         return f"cannot lock {self.path}"
+
+    def free_reserve(self):
+        if self._fd is not None:
+            os.ftruncate(self._fd, len(self._header))
 
     def release(self):
         if self._fd is not None:

@@ -1,0 +1,185 @@
+"""Faults a run survives (issue 20; the full table: benchmarks/faults.py): restarts of finished
+runs, corrupted checkpoints, a full disk (here a file-size limit, no root needed), signals, a
+double run. Every fault ends with one line and a documented exit status, nothing finished is
+lost, and resumed runs equal the uninterrupted run to 1e-12."""
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+from conftest import ENV, load_run, rel_diff, run_cli
+from damage_dolfinx import cli, io
+
+RUN = ["run", "2.4-ex1", "--n", "8", "--k", "0.01", "--T", "0.6", "--no-figures", "--quiet"]
+#: long enough (1500 steps) to be stopped by a signal while it runs
+LONG = ["run", "2.4-ex1", "--n", "8", "--k", "0.001", "--T", "1.5", "--no-figures", "--quiet"]
+
+
+def _main(args, out, capsys):
+    """cli.main in this process (no start-up cost): (exit status, stdout, stderr)."""
+    status = cli.main([*map(str, args), "--out", str(out)])
+    captured = capsys.readouterr()
+    return status, captured.out, captured.err
+
+
+def _max_diff(a, b):
+    _, fa = load_run(a)
+    _, fb = load_run(b)
+    return max(rel_diff(fa[k], fb[k]) for k in fb if not k.endswith("_coords"))
+
+
+def _wait_for_step(out, step, proc, timeout=120):
+    deadline = time.time() + timeout
+    while time.time() < deadline and proc.poll() is None:
+        rows = io.CSVHistory.read_rows(out / "history.csv", 10 ** 9)
+        if rows and int(rows[-1]["step"]) >= step:
+            return
+        time.sleep(0.01)
+    raise AssertionError(f"no step {step} within {timeout} s")
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    out = tmp_path_factory.mktemp("reference")
+    run_cli(RUN + ["--out", out])
+    return out
+
+
+def test_restart_of_a_completed_run_and_run_into_it(tmp_path, capsys, reference):
+    done = tmp_path / "done"
+    assert _main(RUN, done, capsys)[0] == 0
+    files = {f: (done / f).read_bytes() for f in ("summary.json", "history.csv",
+                                                  "fields_final.npz")}
+    status, out, err = _main(RUN + ["--restart"], done, capsys)
+    assert status == 0 and "nothing to do" in out and "completed" in out
+    assert all((done / f).read_bytes() == data for f, data in files.items())
+    status, out, err = _main(RUN, done, capsys)  # no --restart, no --overwrite: refused
+    assert status == 2 and "holds a finished run" in err and err.count("\n") == 1
+    assert all((done / f).read_bytes() == data for f, data in files.items())
+    # a larger T continues from the final checkpoint: same as a run straight to that T
+    longer = RUN[:-4] + ["--T", "0.8", "--no-figures", "--quiet"]
+    assert _main(longer + ["--restart"], done, capsys)[0] == 0
+    straight = tmp_path / "straight"
+    assert _main(longer, straight, capsys)[0] == 0
+    summary = json.loads((done / "summary.json").read_text())
+    assert summary["status"] == "completed" and summary["restarts"][0]["step"] == 60
+    assert _max_diff(done, straight) < 1e-12
+    assert len((done / "history.csv").read_text().splitlines()) == 1 + 80 + 1
+    assert _main(RUN + ["--overwrite"], done, capsys)[0] == 0
+    assert _max_diff(done, reference) < 1e-12
+
+
+@pytest.mark.parametrize("damage", ["truncated", "zero-length"])
+def test_unreadable_checkpoint_falls_back_to_the_previous(tmp_path, capsys, reference, damage):
+    out = tmp_path / "run"
+    assert _main(RUN[:-4] + ["--T", "0.4", "--no-figures", "--quiet", "--checkpoint-every",
+                             "10"], out, capsys)[0] == 0  # generations at steps 40 and 30
+    path = out / "checkpoint.npz"
+    with open(path, "r+b") as f:
+        f.truncate(path.stat().st_size // 2 if damage == "truncated" else 0)
+    status, _, err = _main(RUN + ["--checkpoint-every", "10", "--restart"], out, capsys)
+    assert status == 0 and "checkpoint.npz is unreadable" in err
+    assert "restarting from checkpoint.prev.npz (step 30)" in err and "Traceback" not in err
+    assert _max_diff(out, reference) < 1e-12
+
+
+def test_no_readable_checkpoint_is_refused(tmp_path, capsys):
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "checkpoint.npz").write_bytes(b"")
+    status, _, err = _main(RUN + ["--restart"], out, capsys)
+    assert status == 2 and "no readable checkpoint" in err and err.count("\n") == 1
+
+
+#: the command line under a file-size limit (set after MPI_Init, whose shared-memory files it
+#: would break): writes beyond it fail with EFBIG, as a full disk fails with ENOSPC
+LIMITED = """import signal, resource, sys
+from mpi4py import MPI
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[1]), resource.RLIM_INFINITY))
+from damage_dolfinx.cli import main
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def test_output_error_stops_the_run_and_restart_continues(tmp_path, reference):
+    """A write failing mid-run (fields.h5 reaches a 120 kB file-size limit): exit status 4,
+    one line naming file and step, summary.json 'failed', the finished steps kept; --restart
+    without the limit ends equal to the uninterrupted run."""
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-c", LIMITED, "120000", *RUN, "--checkpoint-every", "10",
+           "--write-every", "3", "--out", str(out)]
+    proc = subprocess.run(cmd, env=ENV, capture_output=True, text=True)
+    assert proc.returncode == 4, proc.stderr
+    line = proc.stderr.strip()
+    assert line.count("\n") == 0 and "Traceback" not in line
+    assert line.startswith("damage-dolfinx: output error: cannot write fields.xdmf (+ .h5) at "
+                           "step "), line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["error"] in line
+    step = summary["steps_done"]
+    rows = io.CSVHistory.read_rows(out / "history.csv", 10 ** 9)
+    assert int(rows[-1]["step"]) == step and 0 < step < 60
+    run_cli(RUN + ["--checkpoint-every", "10", "--write-every", "3", "--restart", "--out", out])
+    assert _max_diff(out, reference) < 1e-12
+
+
+@pytest.mark.parametrize("sig, np_", [(signal.SIGTERM, 1), (signal.SIGINT, 1),
+                                      pytest.param(signal.SIGTERM, 2, marks=pytest.mark.mpi)])
+def test_signal_writes_a_checkpoint_and_marks_the_summary(tmp_path, sig, np_):
+    """SIGTERM/SIGINT (to the process, or to every rank as a batch scheduler does): a
+    checkpoint at the end of the current step, status 'interrupted', exit status 128 + sig."""
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "damage_dolfinx.cli", *LONG, "--out", str(out)]
+    if np_ > 1:
+        cmd = ["mpirun", "-n", str(np_), *cmd]
+    proc = subprocess.Popen(cmd, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    _wait_for_step(out, 50, proc)
+    ranks = subprocess.run(["pgrep", "-s", str(proc.pid), "-f", "damage_dolfinx.cli"],
+                           capture_output=True, text=True).stdout.split()
+    for pid in ranks if np_ > 1 else [proc.pid]:
+        if np_ == 1 or int(pid) != proc.pid:
+            os.kill(int(pid), sig)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 128 + sig, err
+    ours = [line for line in err.splitlines() if line.startswith("damage-dolfinx:")]
+    assert len(ours) == 1 and f"stopped by {signal.Signals(sig).name} after step" in ours[0]
+    assert "Traceback" not in err
+    summary = json.loads((out / "summary.json").read_text())
+    meta = json.loads((out / "checkpoint.json").read_text())
+    assert summary["status"] == "interrupted" and summary["signal"] == signal.Signals(sig).name
+    assert meta["step"] == summary["steps_done"] < 1500
+    assert not (out / ".lock").exists()
+
+
+def test_double_run_is_refused_and_a_dead_runs_lock_does_not_block(tmp_path, capsys):
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "damage_dolfinx.cli", *LONG, "--checkpoint-every", "20",
+           "--out", str(out)]
+    proc = subprocess.Popen(cmd, env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        _wait_for_step(out, 30, proc)
+        status, _, err = _main(LONG + ["--overwrite"], out, capsys)
+        assert status == 2 and "a run is live in" in err and f"pid {proc.pid}" in err
+    finally:
+        proc.kill()
+        proc.wait()
+    assert (out / ".lock").exists()  # SIGKILL: the file stays, its lock died with the process
+    status, _, err = _main(LONG + ["--checkpoint-every", "20", "--restart"], out, capsys)
+    assert status == 0, err
+    assert json.loads((out / "summary.json").read_text())["status"] == "completed"
+
+
+def test_history_restart_drops_a_row_cut_by_a_full_disk(tmp_path):
+    path = tmp_path / "history.csv"
+    path.write_text("step,t,x\n0,0.0,1\n1,0.1,2\n2,0.2,3\n3,0.3")  # row 3 cut mid-way
+    rows = io.CSVHistory.read_rows(path, 10)
+    assert [r["step"] for r in rows] == ["0", "1", "2"]
+    assert [r["step"] for r in io.CSVHistory.read_rows(path, 1)] == ["0", "1"]
