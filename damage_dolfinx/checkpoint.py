@@ -74,7 +74,7 @@ def save(out, state: dict, meta: dict, comm=MPI.COMM_WORLD):
         if comm.rank != 0:
             return
         newest = out / GENERATIONS[0]
-        io.atomic_write_bytes(out / GENERATIONS[2], lambda f: np.savez(f, **gathered), fsync=True)
+        io.atomic_write_bytes(out / GENERATIONS[2], io.npz_writer(gathered), fsync=True)
         # the complete new file exists: the previous generation can move aside
         if newest.exists():
             os.replace(newest, out / GENERATIONS[1])

@@ -123,13 +123,13 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         with StopSignals() as signals:
             return _run(ex, configured, out, n, k, T, h, overrides, write_every, progress,
                         figures, time_limit, checkpoint_every, checkpoint_seconds, restart,
-                        overwrite, comm, signals)
+                        overwrite, comm, signals, lock)
     finally:
         lock.release()
 
 
 def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figures, time_limit,
-         checkpoint_every, checkpoint_seconds, restart, overwrite, comm, signals) -> dict:
+         checkpoint_every, checkpoint_seconds, restart, overwrite, comm, signals, lock) -> dict:
     wall_start = time.perf_counter()
     params, grid, n, h, mesh_file = configured
     settings = {"example": ex.id, "n": n, "h": h, "k": grid.k, "overrides": overrides or {},
@@ -311,7 +311,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         summary.update(status="failed", error=str(exc),
                        wall_time_s=previous_wall + time.perf_counter() - wall_start)
         if comm.rank == 0:
-            try:  # where space allows
+            lock.free_reserve()
+            try:  # where space allows (the lock's reserve is freed for it)
                 io.write_json(out / "summary.json", summary, comm)
             except OSError:
                 pass
