@@ -27,7 +27,7 @@ import numpy as np
 DPI = 150
 DAMAGE_CMAP = "viridis"        # dark = low zeta = damaged (stated in the colour-bar label)
 STRESS_CMAP = "inferno"
-DAMAGE_LABEL = r"$\zeta$ (1 = sound, $\zeta^*$ = fully damaged)"
+DAMAGE_LABEL = "$\\zeta$ (1 = sound,\n$\\zeta^*$ = fully damaged)"
 #: factors stated in thesis captions (2.12 x3, 3.4 x4); kept as the thesis prints them
 THESIS_FACTORS = (3.0, 4.0)
 
@@ -250,8 +250,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
         if ref_xy is not None:
             draw_outline(ax, np.asarray(ref_xy))
         _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else []))
-    full = mathtext(title) + (f" — {amplification_text(amplification)}"
-                              if amplification != 1 or mesh_only else "")
+    full = mathtext(title) + f" — {amplification_text(amplification)}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
     fig.savefig(path, dpi=DPI, bbox_inches="tight")

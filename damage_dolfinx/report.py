@@ -107,10 +107,15 @@ class Figures:
                 if r["example"] == example]
 
     def extra(self, example, thesis_files):
-        """Non-thesis PNGs of an example (best source only)."""
+        """Non-thesis PNGs of an example (best source only), without the other variants'
+        copies of a thesis figure (e.g. the Coulomb run's copy of the setting 2.22)."""
+        stems = {re.sub(r"_(tresca|coulomb|undamaged|damaged|a|b)$", "", Path(f).stem)
+                 for f in thesis_files}
         for folder, index, mode in self.sources[:1]:
             return [(folder / f["file"], f) for f in index["figures"] if f["example"] == example
-                    and f["file"] not in thesis_files and (folder / f["file"]).is_file()]
+                    and f["file"] not in thesis_files and (folder / f["file"]).is_file()
+                    and re.sub(r"_(tresca|coulomb|undamaged|damaged|a|b)$", "",
+                               Path(f["file"]).stem) not in stems]
         return []
 
 

@@ -109,7 +109,7 @@ def _inline(text) -> str:
     text = html.escape(text)
     text = re.sub(r"`([^`]+)`", r"<code>\1</code>", text)
     text = re.sub(r"\[([^]]+)\]\(#([\w-]+)\)", r'<a href="#\2">\1</a>', text)
-    text = re.sub(r"\*\*([^*]+)\*\*", r"<b>\1</b>", text)
+    text = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", text)
     return re.sub(r"(?<![\w*])\*([^*]+)\*(?![\w*])", r"<i>\1</i>", text)
 
 
@@ -150,9 +150,10 @@ body {{ font-family: "DejaVu Sans", sans-serif; max-width: 62em; margin: 2em aut
         line-height: 1.4; font-size: 11pt; padding: 0 1em; }}
 header.title {{ border-bottom: 2px solid #333; margin-bottom: 1em; }}
 header.title h1 {{ margin-bottom: 0.2em; }}
-img {{ max-width: 100%; }}
+img {{ max-width: 100%; max-height: 560px; width: auto; height: auto; }}
 figure {{ margin: 1em 0; break-inside: avoid; }}
 figure.n2 img {{ max-width: 49%; vertical-align: top; }}
+@media print {{ img {{ max-height: 11cm; }} }}
 figcaption {{ color: #333; font-size: 90%; margin-top: 0.3em; }}
 table {{ border-collapse: collapse; margin: 0.6em 0; font-size: 85%; break-inside: auto; }}
 tr {{ break-inside: avoid; }}
