@@ -19,6 +19,7 @@ import argparse
 import itertools
 import json
 import os
+import shutil
 import subprocess
 import sys
 import time
@@ -78,6 +79,7 @@ def run(out: Path) -> dict:
     env = dict(os.environ, OMP_NUM_THREADS="1", MPLBACKEND="Agg")
     for ex_id, options in RUNS:
         folder = out / ex_id
+        shutil.rmtree(folder, ignore_errors=True)  # a fresh run each time
         cmd = [sys.executable, "-m", "damage_dolfinx.cli", "run", ex_id, *options,
                "--out", str(folder), "--quiet"]
         t0 = time.perf_counter()
@@ -90,7 +92,7 @@ def run(out: Path) -> dict:
             for key, value in summary.items():
                 if key not in SKIP_TOP:
                     scalars.update(_numeric_leaves(value, key))
-            entry.update(scalars=scalars, fields=str(folder / "fields_final.npz"),
+            entry.update(scalars=scalars, fields=f"{ex_id}/fields_final.npz",
                          cells=summary["mesh"].get("cells"))
         else:
             entry["error"] = (proc.stderr or proc.stdout).strip().splitlines()[-1:]
@@ -136,7 +138,7 @@ def compare(folders, md=None) -> str:
                     if d > worst:
                         worst, worst_key = d, key
             fdiffs, same_mesh = [], True
-            sorted_all = [_sorted_fields(e["fields"]) for e in entries]
+            sorted_all = [_sorted_fields(Path(f) / e["fields"]) for f, e in zip(folders, entries)]
             for fa, fb in itertools.combinations(sorted_all, 2):
                 for name in set(fa) & set(fb):
                     if fa[name][0].shape != fb[name][0].shape or \

@@ -38,7 +38,7 @@ def _npz(out, index, entry):
         return None
     run = next((r for r in index["runs"] if r["example"] == entry["example"]
                 and r["variant"] == entry["variant"]), None)
-    npz = Path(run["folder"]) / Path(entry["source"]).with_suffix(".npz") if run else None
+    npz = Path(run["folder"]) / Path(entry["source"]).with_suffix(".panel.npz") if run else None
     return npz if npz and npz.is_file() else None
 
 

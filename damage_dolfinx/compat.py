@@ -29,6 +29,9 @@ for _handler in logging.getLogger().handlers:
     _handler.addFilter(_WarningsOnly())
 
 DOLFINX_VERSION = dolfinx.__version__
+#: "no limit" for a PETSc tolerance (switches a test off): -1 up to PETSc 3.21; from 3.22 on -1 is
+#: PETSC_DETERMINE (the default value, e.g. divtol 1e4) and PETSC_UNLIMITED = -3 switches it off
+PETSC_UNLIMITED = int(getattr(PETSc, "UNLIMITED", -1))
 ScalarType = getattr(dolfinx, "default_scalar_type", PETSc.ScalarType)
 
 

@@ -24,6 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
+#: suffix of the panel data written beside a field figure (figure_2_1.png -> figure_2_1.panel.npz)
+PANEL_SUFFIX = ".panel.npz"
+
 DPI = 150
 DAMAGE_CMAP = "viridis"        # dark = low zeta = damaged (stated in the colour-bar label)
 STRESS_CMAP = "inferno"
@@ -269,7 +272,7 @@ def suptitle_on_top(fig, text):
 
 
 def save_panels(path, panels, **meta):
-    """The data behind a field figure (``<png>.npz`` + JSON meta), so that a thesis pair can be
+    """The data behind a field figure (``<png stem>.panel.npz`` + JSON meta; not ``.npz``, which would overwrite a run's fields_final.npz behind fields_final.png), so that a thesis pair can be
     re-rendered on a shared stress scale after both runs finished (:func:`render_saved`)."""
     path = Path(path)
     arrays = {}
@@ -281,7 +284,7 @@ def save_panels(path, panels, **meta):
         meta.pop("ref_xy", None)
     meta["panels"] = [{"name": p.get("name", ""), "label": p.get("label", "")} for p in panels]
     arrays["meta"] = np.array(json.dumps(meta))
-    np.savez_compressed(path.with_suffix(".npz"), **arrays)
+    np.savez_compressed(path.with_suffix(PANEL_SUFFIX), **arrays)
 
 
 def load_panels(npz):

@@ -574,7 +574,7 @@ class RegularisedNewton:
     def _stick_set(self, x):
         """What the Jacobian depends on besides constants: eps, the shift and the nodes with
         |v_tau| <= eps (nodal quadrature), read from the SNES iterate x."""
-        v = x.getArray().reshape(-1, 2)[self.nodes.dofs]
+        v = x.getArray(readonly=True).reshape(-1, 2)[self.nodes.dofs]
         stick = np.abs(np.einsum("ic,ic->i", v, self.nodes.tau)) <= self.eps.value
         return np.concatenate([[float(self.eps.value), float(self.shift.value)], stick])
 

@@ -97,7 +97,7 @@ class Figures:
         if run is None or not entry.get("source"):
             return None
         for base in (Path(run["folder"]), folder / "runs" / Path(run["folder"]).name):
-            npz = base / Path(entry["source"]).with_suffix(".npz")
+            npz = base / Path(entry["source"]).with_suffix(".panel.npz")
             if npz.is_file():
                 return npz
         return None

@@ -247,7 +247,7 @@ def form_callbacks(F, J, u, bcs):
 #: Newton defaults (semismooth Newton on max(., 0) terms); override with -<prefix>snes_* options
 NEWTON = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol": 1e-10,
           "snes_atol": 1e-10, "snes_stol": 1e-14, "snes_max_it": 50,
-          "snes_divergence_tolerance": -1, **DIRECT}
+          "snes_divergence_tolerance": compat.PETSC_UNLIMITED, **DIRECT}
 
 
 def _relative_change(A, P) -> float:

@@ -38,11 +38,11 @@ def test_damage_colour_bar_is_fixed_on_a_small_run(tmp_path):
     summary = runner.run("3.2-ex2", tmp_path, n=4, T=0.05, progress=False)
     figures = {f["file"]: f for f in summary["outputs"]["figures"]}
     zeta_star = summary["parameters"]["zeta_star"]
-    (panel, limits), = _damage_limits(tmp_path / "figure_3_12.npz")
+    (panel, limits), = _damage_limits(tmp_path / "figure_3_12.panel.npz")
     assert np.min(panel["values"]) > 0.5                     # the field is nearly sound ...
     assert limits == (zeta_star, 1.0)                        # ... the bar is not autoscaled
     assert figures["figure_3_12.png"]["amplification"] == 5.0  # the factor of its pair 3.11
-    _, meta, _ = figstyle.load_panels(tmp_path / "figure_3_11.npz")
+    _, meta, _ = figstyle.load_panels(tmp_path / "figure_3_11.panel.npz")
     assert meta["mesh_only"] and meta["amplification"] == 5.0   # deformed mesh, no colour field
 
 
@@ -65,7 +65,7 @@ def test_pair_shares_the_stress_scale(tmp_path):
                   {"xy": xy, "values": np.array([[1.0, 0.9, 0.8]]), "name": "zeta", "label": "zeta"}]
         figstyle.save_panels(tmp_path / f"{name}.png", panels, title=name, amplification=1.0,
                              zeta_star=0.01, mesh_only=False)
-    a, b = figstyle.render_pair(tmp_path / "a.npz", tmp_path / "b.npz", tmp_path / "a.png",
+    a, b = figstyle.render_pair(tmp_path / "a.panel.npz", tmp_path / "b.panel.npz", tmp_path / "a.png",
                                 tmp_path / "b.png")
     assert a[0] == b[0] == (0.0, 9.0) and a[1] == b[1] == (0.01, 1.0)
 
