@@ -196,11 +196,41 @@ class XDMFSeries:
                 f.write_mesh(msh)
 
     def write(self, functions, t: float):
+        """Append the fields at ``t``. DOLFINx rewrites the whole XML file in place, so a copy
+        of it (``.xdmf.bak``) exists while it does: a run killed then leaves a complete
+        previous XML, which ``repair_xdmf`` puts back."""
+        backup = self.path.with_name(self.path.name + ".bak")
+        if self.comm.rank == 0:
+            shutil.copyfile(self.path, backup)
         f = compat.xdmf_file(self.comm, self.path, "a")
         with _failed_files_kept(f), _stderr_held_back():
             with f:
                 for fn in functions:
                     f.write_function(fn, t)
+        if self.comm.rank == 0:
+            backup.unlink()
+
+
+def repair_xdmf(out) -> list:
+    """Put back the XML of every XDMF file in ``out`` whose write was killed (it does not
+    parse and its ``.bak`` does); returns the names repaired (rank 0)."""
+    import xml.etree.ElementTree as ET
+    repaired = []
+    for backup in sorted(Path(out).glob("*.xdmf.bak")):
+        path = backup.with_name(backup.name[:-4])
+        try:
+            ET.parse(path)
+            backup.unlink()  # the write had finished
+            continue
+        except (ET.ParseError, OSError):
+            pass
+        try:
+            ET.parse(backup)
+        except (ET.ParseError, OSError):
+            continue
+        os.replace(backup, path)
+        repaired.append(path.name)
+    return repaired
 
 
 #: XDMF files whose close failed: DOLFINx 0.5 / HDF5 crash (SIGSEGV) when such a file is

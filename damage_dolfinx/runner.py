@@ -23,6 +23,7 @@ import json
 import math
 import os
 import signal
+import sys
 import threading
 import time
 from pathlib import Path
@@ -153,6 +154,11 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         io.collective(comm, out, f"(remove) the previous run in {out}", _remove_run_files, out,
                       comm)
     path, resume = resume or (None, None)
+    if resume:
+        repaired = comm.bcast(io.repair_xdmf(out) if comm.rank == 0 else None)
+        if repaired and comm.rank == 0:
+            print(f"damage-dolfinx: {', '.join(repaired)} restored to its last complete output "
+                  "time (the run was killed while writing it)", file=sys.stderr, flush=True)
     stepper = ex.build(comm, n, k, T, h, overrides, mesh_file)
     if (resume or checkpoint_every) and not stepper.checkpoint_supported:
         raise InputError(f"example {ex.id} does not support checkpoints")

@@ -183,3 +183,15 @@ def test_history_restart_drops_a_row_cut_by_a_full_disk(tmp_path):
     rows = io.CSVHistory.read_rows(path, 10)
     assert [r["step"] for r in rows] == ["0", "1", "2"]
     assert [r["step"] for r in io.CSVHistory.read_rows(path, 1)] == ["0", "1"]
+
+
+def test_xdmf_killed_mid_write_is_restored_from_its_copy(tmp_path):
+    """DOLFINx rewrites the XDMF XML in place; io.XDMFSeries keeps a copy while it does."""
+    good = '<?xml version="1.0"?>\n<Xdmf><Domain><Grid Name="mesh"/></Domain></Xdmf>\n'
+    (tmp_path / "fields.xdmf").write_text(good[:40])  # killed mid-write
+    (tmp_path / "fields.xdmf.bak").write_text(good)
+    (tmp_path / "other.xdmf").write_text(good)  # a finished write whose copy was left
+    (tmp_path / "other.xdmf.bak").write_text(good)
+    assert io.repair_xdmf(tmp_path) == ["fields.xdmf"]
+    assert (tmp_path / "fields.xdmf").read_text() == good
+    assert not list(tmp_path.glob("*.bak"))
