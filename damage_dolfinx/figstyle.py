@@ -45,7 +45,7 @@ _MATH = [  # (pattern, replacement), applied in order to ASCII labels
     (r"\bsigma_nu\b", r"$\\sigma_\\nu$"),
     (r"\bu_tau\b", r"$u_\\tau$"),
     (r"\bu_(\d)\b", r"$u_\1$"),
-    (r"\bx(\d)\b", r"$x_\1$"),
+    (r"\bx([12])\b(?=\s*[=\[,)])(?<!\(x[12])", r"$x_\1$"),  # x1 [m], x2 = 3; not '(x2)' factors
     (r"\beps_reg\b", r"$\\varepsilon$"),
 ]
 

@@ -118,11 +118,19 @@ def _demote_headings(text) -> str:
 
 
 def _markdown_to_html(text) -> str:
-    """Headings, pipe tables and paragraphs (the subset our tables use)."""
-    out, lines, i = [], text.splitlines(), 0
+    """Headings, pipe tables, bullet lists, fenced code and paragraphs (consecutive lines
+    joined) -- the subset our tables and benchmarks/readings.md use."""
+    out, lines, i, para = [], text.splitlines(), 0, []
+
+    def flush():
+        if para:
+            out.append(f"<p>{_inline(' '.join(para))}</p>")
+            para.clear()
+
     while i < len(lines):
         line = lines[i]
         if line.startswith("|"):
+            flush()
             rows = []
             while i < len(lines) and lines[i].startswith("|"):
                 cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
@@ -134,12 +142,38 @@ def _markdown_to_html(text) -> str:
                        + "".join("<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in r) + "</tr>"
                                  for r in rest) + "</table>")
             continue
+        if line.startswith("```"):
+            flush()
+            j = i + 1
+            while j < len(lines) and not lines[j].startswith("```"):
+                j += 1
+            out.append(f"<pre><code>{html.escape(chr(10).join(lines[i + 1:j]))}</code></pre>")
+            i = j + 1
+            continue
         m = re.match(r"^(#+) (.*)", line)
+        bullet = re.match(r"^\s*[-*] (.*)", line)
         if m:
+            flush()
             out.append(f"<h{len(m.group(1))}>{_inline(m.group(2))}</h{len(m.group(1))}>")
+        elif bullet:
+            flush()
+            items = [bullet.group(1)]
+            i += 1
+            while i < len(lines) and lines[i].strip() and not lines[i].startswith(("|", "#")):
+                nxt = re.match(r"^\s*[-*] (.*)", lines[i])
+                if nxt:
+                    items.append(nxt.group(1))
+                else:
+                    items[-1] += " " + lines[i].strip()
+                i += 1
+            out.append("<ul>" + "".join(f"<li>{_inline(x)}</li>" for x in items) + "</ul>")
+            continue
         elif line.strip():
-            out.append(f"<p>{_inline(line)}</p>")
+            para.append(line.strip())
+        else:
+            flush()
         i += 1
+    flush()
     return "\n".join(out)
 
 
