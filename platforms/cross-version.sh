@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The same small run per problem on DOLFINx 0.5.2 (this Debian 12 machine), 0.9 (trixie root) and
+# 0.11 (sid root), all from one clean clone of the committed HEAD, then the comparison table:
+#   platforms/cross-version.sh [OUT.md]     (default results/cross_version.md)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd); repo=$(dirname "$here")
+. "$here/lib.sh"
+[ "$(id -u)" = 0 ] || { echo "cross-version: needs root (debootstrap, chroot)" >&2; exit 2; }
+md=${1:-$repo/results/cross_version.md}
+mkdir -p "$(dirname "$md")"
+work=$(mktemp -d /tmp/cross-version.XXXXXX)
+copy_clone "$repo" "$work/clone"
+(cd "$work/clone" && make -s setup >/dev/null && .venv/bin/python benchmarks/cross_version.py run --out "$work/bookworm")
+folders=("$work/bookworm")
+for suite in trixie sid; do
+  root=$(stack_root "$suite")
+  copy_clone "$repo" "$root/opt/damage-dolfinx"
+  in_root "$root" "cd /opt/damage-dolfinx && make -s setup >/dev/null && .venv/bin/python benchmarks/cross_version.py run --out /opt/cross-version"
+  rm -rf "$work/$suite"; cp -r "$root/opt/cross-version" "$work/$suite"
+  folders+=("$work/$suite")
+done
+"$work/clone/.venv/bin/python" "$work/clone/benchmarks/cross_version.py" compare "${folders[@]}" --md "$md"
+echo "cross-version: table in $md (runs in $work)"
