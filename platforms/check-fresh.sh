@@ -36,10 +36,10 @@ for cmd in "make demo" "make test"; do
   log="$root.$(echo "$cmd" | tr ' ' -).log"
   s=$SECONDS; rc=0
   in_root "$root" "$(run "$cmd")" >"$log" 2>&1 || rc=$?
-  dt=$((SECONDS - s))
+  dt=$((SECONDS - s)); load=$(cut -d' ' -f1-3 /proc/loadavg)
   echo "check-fresh: '$cmd' in a fresh $SUITE minbase root$([ "$AS_USER" = 1 ] && echo ' as a non-root sudoer'): exit $rc, ${dt} s (log $log)"
   tail -3 "$log" | sed 's/^/    /'
-  result+=("{\"command\": \"$cmd\", \"exit\": $rc, \"wall_time_s\": $dt, \"last_line\": $(tail -1 "$log" | python3 -c 'import json,sys; print(json.dumps(sys.stdin.read().strip()))')}")
+  result+=("{\"command\": \"$cmd\", \"exit\": $rc, \"wall_time_s\": $dt, \"loadavg_after\": \"$load\", \"last_line\": $(tail -1 "$log" | python3 -c 'import json,sys; print(json.dumps(sys.stdin.read().strip()))')}")
 done
 commit=$(git -C "$repo" rev-parse --short HEAD)
 ( IFS=,; echo "{\"suite\": \"$SUITE\", \"as_user\": $AS_USER, \"commit\": \"$commit\", \"debootstrap_s\": $t_boot, \"commands\": [${result[*]}]}" ) \
