@@ -102,6 +102,17 @@ class Figures:
                 return npz
         return None
 
+    def run_folder(self, entry):
+        """The run folder behind a figure entry of an index (None if unknown)."""
+        for folder, index, _ in self.sources:
+            run = next((r for r in index["runs"] if r["example"] == entry.get("example")
+                        and r["variant"] == entry.get("variant")), None)
+            if run:
+                for base in (Path(run["folder"]), folder / "runs" / Path(run["folder"]).name):
+                    if base.is_dir():
+                        return base
+        return None
+
     def runs(self, example):
         return [(mode, r) for _, index, mode in self.sources[:1] for r in index["runs"]
                 if r["example"] == example]
@@ -148,7 +159,7 @@ def _bridge_summary(results: Path):
 def build(results: Path) -> Path:
     """Write results/REPORT.md and results/REPORT.html; returns the HTML path."""
     from . import examples, reproduce
-    from .report_figures import THESIS_FIGURES, judge
+    from .report_figures import THESIS_FIGURES, judge, run_context
     results = Path(results).resolve()
     results.mkdir(parents=True, exist_ok=True)
     doc = Doc(results)
@@ -198,7 +209,10 @@ def build(results: Path) -> Path:
             else:
                 verdict, got = "not comparable (thesis table withheld)", "our convergence plot"
         else:
-            context = {"n_hinges": bridge.get("n_hinges")} if bridge and fig.example == "2.1-ex3" else {}
+            context = run_context(figs.run_folder(found[0][3]) if found and found[0] else None)
+            if bridge and fig.example == "2.1-ex3":
+                context.update(hinges=bridge.get("n_mechanism_hinges", bridge.get("n_hinges")),
+                               failure_load_kN=bridge.get("failure_load_kN"))
             verdict, got, failed = judge(fig, [f[2] if f else None for f in found], context)
             if not paths:
                 verdict, got = "not comparable (not produced: run `make figures`)", "-"
