@@ -65,6 +65,11 @@ def describe(exc: BaseException, folder=None) -> str:
     return text
 
 
+#: a rank whose write failed waits this long for the others, then aborts the job: a rank can
+#: be stuck for ever inside a collective HDF5 call that the failed rank left
+STUCK_SECONDS = 60.0
+
+
 def collective(comm, folder, what: str, fn, *args):
     """Run the write ``fn(*args)`` on every rank; an OSError/RuntimeError on any rank raises
     OutputError("cannot write WHAT: reason") on every rank (``what`` names file, step and time)."""
@@ -73,7 +78,19 @@ def collective(comm, folder, what: str, fn, *args):
         fn(*args)
     except (OSError, RuntimeError) as exc:
         error = describe(exc, folder)
-    error = next((e for e in comm.allgather(error) if e), None)
+    if comm.size > 1:
+        failed = np.zeros(comm.size, np.int32)
+        request = comm.Iallgather(np.array([error is not None], np.int32), failed)
+        deadline = time.monotonic() + STUCK_SECONDS
+        while not request.Test():
+            if error is not None and time.monotonic() > deadline:
+                print(f"damage-dolfinx: output error: cannot write {what}: {error} (another "
+                      "rank is stuck in the collective write: job aborted)", file=sys.stderr,
+                      flush=True)
+                comm.Abort(4)
+            time.sleep(0.001)
+        if failed.any():
+            error = comm.bcast(error, root=int(np.flatnonzero(failed)[0]))
     if error:
         raise OutputError(f"cannot write {what}: {error}")
 
@@ -199,9 +216,22 @@ class XDMFSeries:
         """Append the fields at ``t``. DOLFINx rewrites the whole XML file in place, so a copy
         of it (``.xdmf.bak``) exists while it does: a run killed then leaves a complete
         previous XML, which ``repair_xdmf`` puts back."""
-        backup = self.path.with_name(self.path.name + ".bak")
+        backup, error = self.path.with_name(self.path.name + ".bak"), None
+        need = 65536 + 2 * sum(fn.function_space.dofmap.index_map.size_global * 8 * (
+            fn.function_space.dofmap.index_map_bs) + 4096 for fn in functions)
         if self.comm.rank == 0:
-            shutil.copyfile(self.path, backup)
+            try:  # a write that fails half-way can leave ranks inside collective HDF5 calls
+                free = shutil.disk_usage(self.path.parent).free
+                need += 2 * self.path.stat().st_size
+                if free < need:
+                    raise OSError(errno.ENOSPC, f"No space left on device ({free // 1024} kB "
+                                                f"free, the output needs ~{need // 1024} kB)")
+                shutil.copyfile(self.path, backup)
+            except OSError as exc:
+                error = exc
+        error = self.comm.bcast(error, root=0)  # every rank stops before the collective open
+        if error:
+            raise error
         f = compat.xdmf_file(self.comm, self.path, "a")
         with _failed_files_kept(f), _stderr_held_back():
             with f:

@@ -356,7 +356,7 @@ def _previous_run(out, comm):
 def _remove_run_files(out, comm):
     if comm.rank == 0:
         for path in [out / name for name in RUN_FILES] + list(out.glob("fields*.xdmf")) + \
-                list(out.glob("fields*.h5")):
+                list(out.glob("fields*.h5")) + list(out.glob("fields*.xdmf.bak")):
             if path.exists():
                 path.unlink()
 
