@@ -1,14 +1,38 @@
 """Build results/REPORT.md and results/REPORT.html from what `make figures` and
-`make convergence` wrote (and the committed benchmark outputs).
+`make convergence` wrote (and the committed benchmark outputs): title block with the verdict
+counts, table of contents, summary (one row per thesis table and figure, with its verdict and a
+link), known differences, the thesis's tables beside ours (benchmarks/fidelity.py, also written
+to RESULTS/fidelity/), every figure with a caption of what the thesis shows.
 
-    python benchmarks/report.py [--results results]
+    python benchmarks/report.py [--results results] [--pdf]
+
+``--pdf`` also prints RESULTS/REPORT.pdf with headless Chromium (--print-to-pdf).
 """
 import argparse
+import re
+import shutil
+import subprocess
+import tempfile
 
 from damage_dolfinx import report
 
 p = argparse.ArgumentParser()
 p.add_argument("--results", default="results")
+p.add_argument("--pdf", action="store_true", help="also print REPORT.pdf with headless Chromium")
 a = p.parse_args()
 page = report.build(a.results)
-print(f"report: {page} and {page.with_suffix('.md')}")
+counts = re.search(r"\d+ reproduced, \d+ differ, \d+ not comparable", page.read_text())
+print(f"report: {page} and {page.with_suffix('.md')}"
+      + (f" ({counts.group(0)})" if counts else ""))
+chromium = shutil.which("chromium") or shutil.which("chromium-browser")
+if a.pdf and chromium:
+    with tempfile.TemporaryDirectory() as profile:
+        subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu",
+                        "--disable-background-networking", "--disable-component-update",
+                        "--disable-sync", "--no-first-run", f"--user-data-dir={profile}",
+                        "--virtual-time-budget=15000", "--no-pdf-header-footer",
+                        f"--print-to-pdf={page.with_suffix('.pdf')}", page.as_uri()],
+                       check=True, capture_output=True, timeout=300)
+    print(f"pdf: {page.with_suffix('.pdf')}")
+elif a.pdf:
+    print("pdf: chromium not found (make setup installs it)")
