@@ -4,7 +4,7 @@ import math
 
 import ufl
 
-from ..examples import Example, Figure
+from ..examples import Example, Figure, Reading
 from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .section_2_2 import OMEGA_PD, RHO_UZAWA
 
@@ -19,6 +19,21 @@ def _params(g_fric, law="tresca"):
                "eps_reg": 1e-9,
                "friction_solver": "newton", "rho_uzawa": RHO_UZAWA, "omega_pd": OMEGA_PD,
                "friction_tol": 1e-6})
+
+
+#: evidence reading of Example 1 (issue 16, benchmarks/readings.md)
+EVIDENCE_EX1 = Reading(
+    traction=lambda x, t: ufl.as_vector((50.0 * (ufl.exp(t) - 1.0), 0.0)),
+    overrides={"stress_in_error": "no"},
+    assumptions=[
+        "R1 (evidence reading): f_N = (50, 0)(e^t - 1) instead of (50, 0)e^t (line 2747), "
+        "the reading of Section 2.2 (R1 there; line 3973 prints (e^t - 1) for the same "
+        "unit-square setting); with u_0 = 0, sigma_0 = 0 (line 2747) the load then starts "
+        "from zero (G19b's jump disappears)",
+        "R2 (evidence reading): e_hk without ||sigma - sigma_hk||_Q (the formula, line 2751, "
+        "includes it): the load fixes ||sigma|| ~ 55-137 and the P0 stress error alone is "
+        "~67x the thesis's whole e_hk at n = 8 under every reading tried "
+        "(benchmarks/readings.md)"])
 
 
 def examples():
@@ -42,7 +57,7 @@ def examples():
     square = lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {  # noqa: E731
         GAMMA_D: side(0, 0.0), GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)})
     ex1 = Example(
-        id="2.4-ex1", section="2.4",
+        id="2.4-ex1", section="2.4", readings={"evidence": EVIDENCE_EX1},
         title="unit square, traction (50,0)e^t, Tresca g = 0.7 (P1) or simplified Coulomb "
               "mu_f = 0.05, S_n = 10 (P2; --friction-law coulomb): convergence",
         params=_params(0.7), T=1.0, k=0.002, n=64, diameter=math.sqrt(2),
