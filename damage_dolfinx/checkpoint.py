@@ -28,6 +28,8 @@ from . import compat, io
 from .parameters import InputError
 
 FORMAT = "damage-dolfinx/checkpoint/v1"
+#: statuses of a run that has nothing left to do (a larger T continues a "completed" one)
+FINISHED = ("completed", "zeta_star_reached", "collapse")
 #: keys are compared after rounding to this length (meshes of the thesis: 1e-3 .. 1e2 m)
 KEY_RESOLUTION = 1e-9
 
@@ -123,6 +125,31 @@ def _latest(out: Path):
         return None, None, [], (f"cannot restart: no checkpoint in {str(out)!r} "
                                 "(checkpoint.npz missing)")
     return None, None, [], f"cannot restart: no readable checkpoint in {str(out)!r} ({'; '.join(notes)})"
+
+
+def resume_point(out, settings, grid, previous, comm=MPI.COMM_WORLD):
+    """(checkpoint file, its metadata) after checking it belongs to this run, or None when the
+    run in ``out`` (``previous``: its summary or None) finished and this T adds no step (nothing
+    to do). Raises InputError if it cannot be resumed."""
+    finished = previous is not None and previous.get("status") in FINISHED
+    try:
+        path, meta = latest(out, comm)
+    except InputError:
+        if not finished:
+            raise
+        path, meta = None, {key: previous.get(key) for key in ("example", "n", "k")}
+    for key, value in settings.items():
+        if key in meta and meta.get(key) != value:
+            raise InputError(f"cannot restart: the {'checkpoint' if path else 'run'} in "
+                             f"{str(out)!r} has {key} = {meta.get(key)!r}, this run {value!r}")
+    if finished and (previous["status"] != "completed" or grid.num_steps <= previous["steps_done"]):
+        return None
+    if path is None:
+        raise InputError(f"cannot continue the completed run in {str(out)!r} to T = {grid.T:g}: "
+                         "it has no checkpoint (checkpoints were off)")
+    if meta["step"] > grid.num_steps:
+        raise InputError(f"cannot restart: the checkpoint is at t = {meta['t']}, beyond T = {grid.T}")
+    return path, meta
 
 
 def _match(saved: np.ndarray, local: np.ndarray) -> np.ndarray:

@@ -61,8 +61,6 @@ CHECKPOINT_SECONDS = 120.0
 #: signals that stop a run at the end of the current step, with a checkpoint; mpirun (Open MPI)
 #: forwards SIGUSR1 to every rank, while it answers SIGTERM/SIGINT by killing the ranks
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1)
-#: statuses of a run that has nothing left to do (a larger T continues a "completed" one)
-FINISHED = ("completed", "zeta_star_reached", "collapse")
 #: files of a run that --overwrite removes (figures are overwritten by the new run)
 RUN_FILES = ("summary.json", "history.csv", "fields_final.npz", "checkpoint.json",
              *checkpoint.GENERATIONS)
@@ -138,7 +136,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     previous = _previous_run(out, comm)
     resume = None
     if restart:
-        resume = _check_restart(out, settings, grid, previous, comm)
+        resume = checkpoint.resume_point(out, settings, grid, previous, comm)
         if resume is None:
             if comm.rank == 0:
                 print(f"damage-dolfinx: nothing to do: the run in {str(out)!r} ended "
@@ -359,30 +357,6 @@ def _remove_run_files(out, comm):
                 list(out.glob("fields*.h5")) + list(out.glob("fields*.xdmf.bak")):
             if path.exists():
                 path.unlink()
-
-
-def _check_restart(out, settings, grid, previous, comm):
-    """(checkpoint file, its metadata) after checking it belongs to this run, or None when the
-    run in ``out`` finished and this T adds no step (nothing to do)."""
-    finished = previous is not None and previous.get("status") in FINISHED
-    try:
-        path, meta = checkpoint.latest(out, comm)
-    except InputError:
-        if not finished:
-            raise
-        path, meta = None, {key: previous.get(key) for key in ("example", "n", "k")}
-    for key, value in settings.items():
-        if key in meta and meta.get(key) != value:
-            raise InputError(f"cannot restart: the {'checkpoint' if path else 'run'} in "
-                             f"{str(out)!r} has {key} = {meta.get(key)!r}, this run {value!r}")
-    if finished and (previous["status"] != "completed" or grid.num_steps <= previous["steps_done"]):
-        return None
-    if path is None:
-        raise InputError(f"cannot continue the completed run in {str(out)!r} to T = {grid.T:g}: "
-                         "it has no checkpoint (checkpoints were off)")
-    if meta["step"] > grid.num_steps:
-        raise InputError(f"cannot restart: the checkpoint is at t = {meta['t']}, beyond T = {grid.T}")
-    return path, meta
 
 
 def auto_amplification(stepper, diameter) -> float:
