@@ -156,6 +156,16 @@ def expression(expr, V):
     return fem.Expression(expr, interpolation_points(V))
 
 
+def eval_expression(expr, msh, cells):
+    """Values of a compiled fem.Expression at its points in the given local cells
+    (``eval(cells)`` up to 0.8, ``eval(mesh, cells)`` from 0.9 on)."""
+    cells = np.asarray(cells, dtype=np.int32)
+    try:
+        return expr.eval(msh, cells)
+    except TypeError:
+        return expr.eval(cells)
+
+
 def interpolate(u: fem.Function, source):
     """u <- interpolant of a Python callable, a fem.Expression or a Function on the same mesh."""
     u.interpolate(source)

@@ -14,7 +14,7 @@ def evaluate(msh, expr):
     """Value of a spatially constant UFL expression (evaluated at one cell)."""
     V = compat.scalar_dg0(msh)
     e = fem.Expression(expr, compat.interpolation_points(V))
-    return e.eval(np.array([0], dtype=np.int32)).reshape(-1)
+    return compat.eval_expression(e, msh, [0]).reshape(-1)
 
 
 def sym_tensors(count, scale):

@@ -131,6 +131,7 @@ def _shear_block(mu, lam, g, side_shear, top_shear=None, top_velocity=None):
     import ufl
     from dolfinx import fem, mesh
     from mpi4py import MPI
+    from damage_dolfinx import compat
     from damage_dolfinx.friction import FrictionProblem
     from damage_dolfinx.solvers import SolveContext
     msh = mesh.create_rectangle(MPI.COMM_WORLD, [np.zeros(2), np.array([2.0, 1.0])], [8, 4])
@@ -142,7 +143,7 @@ def _shear_block(mu, lam, g, side_shear, top_shear=None, top_velocity=None):
     values = np.concatenate([np.full(f.size, t, dtype=np.int32) for t, f in facets.items()])
     indices, first = np.unique(indices, return_index=True)
     tags = mesh.meshtags(msh, 1, indices, values[first])
-    V = fem.VectorFunctionSpace(msh, ("Lagrange", 1))
+    V = compat.vector_p1(msh)
     u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
     e = lambda f: ufl.sym(ufl.grad(f))  # noqa: E731
     a = 2 * mu * ufl.inner(e(u), e(w)) * ufl.dx + lam * ufl.div(u) * ufl.div(w) * ufl.dx
