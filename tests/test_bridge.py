@@ -190,3 +190,7 @@ def test_failure_load_serial_equals_two_ranks(tmp_path):
     assert p["failure_load_kN"] == s["failure_load_kN"]  # in practice identical
     assert [h["section"] for h in p["hinges"]] == [h["section"] for h in s["hinges"]]
     assert p["failed_sections"] == s["failed_sections"]
+    assert [h["mechanism"] for h in p["hinges"]] == [h["mechanism"] for h in s["hinges"]]
+    assert np.allclose([h["rotation_step_mrad"] for h in p["hinges"]],
+                       [h["rotation_step_mrad"] for h in s["hinges"]], rtol=1e-6, atol=1e-6)
+    assert p["zeta_min_run"] >= 0.01 - 1e-10
