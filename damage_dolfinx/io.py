@@ -244,23 +244,27 @@ class XDMFSeries:
 def repair_xdmf(out) -> list:
     """Put back the XML of every XDMF file in ``out`` whose write was killed (it does not
     parse and its ``.bak`` does); returns the names repaired (rank 0)."""
-    import xml.etree.ElementTree as ET
     repaired = []
     for backup in sorted(Path(out).glob("*.xdmf.bak")):
         path = backup.with_name(backup.name[:-4])
         try:
-            ET.parse(path)
-            backup.unlink()  # the write had finished
-            continue
-        except (ET.ParseError, OSError):
-            pass
-        try:
-            ET.parse(backup)
-        except (ET.ParseError, OSError):
-            continue
-        os.replace(backup, path)
-        repaired.append(path.name)
+            if not _parses(path) and _parses(backup):
+                os.replace(backup, path)
+                repaired.append(path.name)
+            else:
+                backup.unlink()  # the write had finished (or the copy is no better)
+        except OSError:
+            pass  # left as it is: the restart itself does not need it
     return repaired
+
+
+def _parses(path) -> bool:
+    import xml.etree.ElementTree as ET
+    try:
+        ET.parse(path)
+        return True
+    except (ET.ParseError, OSError):
+        return False
 
 
 #: XDMF files whose close failed: DOLFINx 0.5 / HDF5 crash (SIGSEGV) when such a file is
