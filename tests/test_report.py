@@ -69,7 +69,8 @@ def test_resumed_reproduction_keeps_completed_runs(tmp_path):
     index = json.loads((out / "index.json").read_text())
     index["runs"] = [r for r in index["runs"] if r["example"] != "2.3-ex1"]
     (out / "index.json").write_text(json.dumps(index))
-    (out / "runs" / "2.3-ex1" / "checkpoint.json").write_text("{}")  # not a valid checkpoint
+    summary = out / "runs" / "2.3-ex1" / "summary.json"  # as a killed run leaves it
+    summary.write_text(json.dumps({**json.loads(summary.read_text()), "status": "running"}))
     third = reproduce.run_figures("quick", out, np_=1, only=["2.3-ex1"], resume=True)
-    assert "--restart" in third["runs"][0]["command"] and third["runs"][0]["returncode"] != 0
-    assert "checkpoint" in (out / "runs" / "2.3-ex1" / "log.txt").read_text()
+    assert "--restart" in third["runs"][0]["command"] and third["runs"][0]["returncode"] == 0
+    assert json.loads(summary.read_text())["restarts"]  # went on from its (final) checkpoint
