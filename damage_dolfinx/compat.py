@@ -215,7 +215,8 @@ def num_owned_cells(msh) -> int:
 def cell_vertex_coords(msh):
     """(n_owned_cells, nverts, 2) coordinates of the owned cells' geometry nodes (P1 meshes)."""
     nc = num_owned_cells(msh)
-    dm = msh.geometry.dofmap
+    dms = getattr(msh.geometry, "dofmaps", None)  # 0.10+: one dofmap per cell type
+    dm = (dms(0) if callable(dms) else dms[0]) if dms is not None else msh.geometry.dofmap
     conn = dm.array.reshape(-1, dm.links(0).size)[:nc] if hasattr(dm, "array") else dm[:nc]
     return msh.geometry.x[conn][:, :, :2]
 

@@ -182,7 +182,9 @@ def test_example2_central_damage_heals(tmp_path):
     assert prof["x2"] == 3.0 and z0 == pytest.approx(0.1)
     assert z_end > 0.2
     assert summary["k"] < 0.8 * summary["k_max"]
-    assert summary["probe"] == [0.0, 6.0] and summary["final"]["zeta_probe"] > 0.99
+    # the probe is a mesh vertex: its coordinates carry the mesh generator's round-off
+    # (-8e-18 instead of 0 on DOLFINx 0.11)
+    assert summary["probe"] == pytest.approx([0.0, 6.0], abs=1e-12) and summary["final"]["zeta_probe"] > 0.99
 
 
 def test_implicit_variant_close_for_small_k():
