@@ -14,7 +14,7 @@ here=$(cd "$(dirname "$0")" && pwd); repo=$(dirname "$here")
 command -v debootstrap >/dev/null || { echo "check-fresh: debootstrap missing (apt-get install debootstrap)" >&2; exit 2; }
 SUITE=${SUITE:-bookworm}
 AS_USER=${AS_USER:-0}
-OUT=${OUT:-$repo/results/check-fresh$([ "$AS_USER" = 1 ] && echo -user).json}
+OUT=${OUT:-$repo/results/check-fresh$([ "$AS_USER" = 1 ] && echo -user || true).json}
 root="$ROOTS_DIR/fresh-$SUITE"
 mkdir -p "$(dirname "$OUT")"
 t0=$SECONDS
@@ -37,7 +37,7 @@ for cmd in "make demo" "make test"; do
   s=$SECONDS; rc=0
   in_root "$root" "$(run "$cmd")" >"$log" 2>&1 || rc=$?
   dt=$((SECONDS - s)); load=$(cut -d' ' -f1-3 /proc/loadavg)
-  echo "check-fresh: '$cmd' in a fresh $SUITE minbase root$([ "$AS_USER" = 1 ] && echo ' as a non-root sudoer'): exit $rc, ${dt} s (log $log)"
+  echo "check-fresh: '$cmd' in a fresh $SUITE minbase root$([ "$AS_USER" = 1 ] && echo ' as a non-root sudoer' || true): exit $rc, ${dt} s (log $log)"
   tail -3 "$log" | sed 's/^/    /'
   result+=("{\"command\": \"$cmd\", \"exit\": $rc, \"wall_time_s\": $dt, \"loadavg_after\": \"$load\", \"last_line\": $(tail -1 "$log" | python3 -c 'import json,sys; print(json.dumps(sys.stdin.read().strip()))')}")
 done
