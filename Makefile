@@ -21,7 +21,7 @@ APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl pyth
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT := $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get
 
-.PHONY: setup system-deps demo test bench convergence convergence-quick figures figures-quick \
+.PHONY: setup system-deps demo test check-fresh test-platforms cross-version bench convergence convergence-quick figures figures-quick \
     report clean
 
 setup: $(VENV)/.installed
@@ -76,6 +76,19 @@ figures-quick: setup
 # results/REPORT.md and results/REPORT.html from the figures, tables and benchmark outputs.
 report: setup
 	$(PY) benchmarks/report.py --results $(OUT)
+
+# Platforms (root, debootstrap; roots cached in /var/cache/damage-dolfinx/roots, rebuilt when
+# missing): the README's two commands in a bare Debian 12 minbase root (AS_USER=1: as a non-root
+# sudoer); the test suite on Debian 13 / DOLFINx 0.9 and Debian unstable / DOLFINx 0.11; the
+# same small run per problem on all three versions, compared.
+check-fresh:
+	bash platforms/check-fresh.sh
+
+test-platforms:
+	bash platforms/suite.sh trixie sid
+
+cross-version:
+	bash platforms/cross-version.sh $(OUT)/cross_version.md
 
 clean:
 	rm -rf $(VENV) results .pytest_cache build *.egg-info
