@@ -50,7 +50,7 @@ demo: setup
 	@echo "demo output (XDMF for ParaView, PNG figures, CSV, summary.json) in $(OUT)/demo/"
 
 test: setup
-	$(PY) -m pytest -q -ra tests
+	$(PY) -m pytest -q -ra tests $(PYTEST_ARGS)
 
 bench: setup
 	$(MPIRUN) $(PY) benchmarks/step_timing_2_1.py

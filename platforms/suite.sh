@@ -7,8 +7,8 @@
 # (default /var/cache/damage-dolfinx/roots, outside the repository) and rebuilt when missing;
 # `rm -rf` it to reclaim the ~3 GB. A clean clone is copied in, set up with the same
 # `make setup` as on Debian 12 (its venv sees the suite's stack), and `pytest` runs there; the
-# suite itself runs every example serially and under mpirun -n 2. Extra arguments after `--` go
-# to pytest. Exit status: pytest's, or 1 with a message when the root cannot be built.
+# suite itself runs every example serially and under mpirun -n 2; it is run with `make test`, as on
+# Debian 12. Extra arguments after `--` go to pytest (PYTEST_ARGS). Exit status: pytest's, or 1 with a message when the root cannot be built.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd); repo=$(dirname "$here")
 . "$here/lib.sh"
@@ -26,7 +26,7 @@ for suite in "${suites[@]}"; do
   copy_clone "$repo" "$root/opt/damage-dolfinx"
   t0=$SECONDS
   r=0
-  in_root "$root" "cd /opt/damage-dolfinx && make setup >/dev/null && .venv/bin/python -c 'import dolfinx; print(\"$suite: DOLFINx\", dolfinx.__version__)' && .venv/bin/python -m pytest -q -ra tests $*" || r=$?
+  in_root "$root" "cd /opt/damage-dolfinx && make setup >/dev/null && .venv/bin/python -c 'import dolfinx; print(\"$suite: DOLFINx\", dolfinx.__version__)' && make test PYTEST_ARGS='$*'" || r=$?
   echo "suite: $suite exit $r in $((SECONDS - t0)) s"
   [ $r = 0 ] || rc=$r
 done
