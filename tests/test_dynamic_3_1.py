@@ -123,8 +123,9 @@ def test_k_max_matches_measured_onset_without_contact():
 
 def contact_oscillation(f):
     """G23 case (3.1 Ex. 1, n = 4, damage frozen): max |second difference of ||v_n|| in time|
-    relative to max ||v_n|| at k = f k_max; the explicit contact chatters beyond k_max."""
-    ex = examples.get("3.1-ex1")
+    relative to max ||v_n|| at k = f k_max; the explicit contact chatters beyond k_max. Literal
+    reading: c_nu = 1/mu = 2e4 (the evidence reading's c_nu = 5e-5 has no contact limit)."""
+    ex = examples.get("3.1-ex1", "literal")
     k_max = ex.build(COMM, n=4, k=1e-3, T=1e-3).stability["k_max"]
     N = int(round(1.0 / (f * k_max)))
     st = ex.build(COMM, n=4, k=1.0 / N, T=1.0,
@@ -149,7 +150,8 @@ def test_k_max_with_contact_matches_measured_onset():
 
 def test_stability_check_error_from_cli(tmp_path):
     proc = run_cli(["run", "3.1-ex1", "--n", "4", "--k", "0.05", "--T", "0.1", "--quiet",
-                    "--set", "stability_check=error", "--out", tmp_path], check=False)
+                    "--reading", "literal", "--set", "stability_check=error", "--out", tmp_path],
+                   check=False)
     assert proc.returncode == 2 and "exceeds the stability limit" in proc.stderr
 
 
@@ -196,8 +198,8 @@ def test_power_iteration_agrees_with_slepc_with_contact():
     """The fallback (power iteration, one factorisation) gives the k_max of the SLEPc path."""
     if stability._slepc() is None:
         pytest.skip("slepc4py not importable")
-    st = examples.get("3.1-ex1").build(COMM, n=8, k=0.01, T=0.01,
-                                       overrides={"stability_check": "off"})
+    st = examples.get("3.1-ex1", "literal").build(COMM, n=8, k=0.01, T=0.01,
+                                                  overrides={"stability_check": "off"})
     ds = ufl.Measure("ds", domain=st.mesh, subdomain_data=st.data.geometry.facet_tags)
     args = (st.v.function_space, st.params.E, st.params.nu, st.rho, st.m_visc, st.c_nu,
             ds(GAMMA_C), st.bcs)
