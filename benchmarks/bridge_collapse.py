@@ -1,7 +1,8 @@
 """Collapse of the masonry arch ring, thesis Section 2.1 Example 3 (GitHub issue 3), default case.
 
     mpirun -n 2 .venv/bin/python benchmarks/bridge_collapse.py [--h 0.05] [--k 0.001]
-        [--set name=value ...] [--out results/bench/bridge] [--plot-only]
+        [--reading literal|evidence] [--set name=value ...] [--out results/bench/bridge]
+        [--plot-only]
 
 Runs catalogue example 2.1-ex3 (8400 triangles / 4515 nodes at h = 0.05, k = 0.001, self weight
 plus P(t) = load_rate t at quarter span, load_rate calibrated to 4500 kN/s, see
@@ -36,6 +37,8 @@ def parse():
     p.add_argument("--k", type=float, default=None, help="time step (default 0.001)")
     p.add_argument("--T", type=float, default=None, help="final time (default 0.3)")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE")
+    p.add_argument("--reading", choices=("literal", "evidence"), default=None,
+                   help="reading of the thesis data (default: evidence = damage in [zeta*, 1])")
     p.add_argument("--out", default="results/bench/bridge")
     p.add_argument("--plot-only", action="store_true", help="redraw from OUT/run")
     return p.parse_args()
@@ -45,7 +48,8 @@ def run(args, comm):
     from damage_dolfinx import runner
     from damage_dolfinx.cli import _overrides
     return runner.run("2.1-ex3", Path(args.out) / "run", h=args.h, k=args.k, T=args.T,
-                      overrides=_overrides(args.set), progress=True, figures=True, comm=comm)
+                      overrides=_overrides(args.set, reading=args.reading), progress=True,
+                      figures=True, comm=comm)
 
 
 def read_history(path):
