@@ -21,7 +21,7 @@ APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl pyth
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT := $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get
 
-.PHONY: setup system-deps demo test check-fresh test-platforms cross-version bench convergence convergence-quick figures figures-quick \
+.PHONY: setup system-deps demo test check-fresh check-paraview test-platforms cross-version bench convergence convergence-quick figures figures-quick \
     report clean
 
 setup: $(VENV)/.installed
@@ -89,6 +89,13 @@ test-platforms:
 
 cross-version:
 	bash platforms/cross-version.sh $(OUT)/cross_version.md
+
+# ParaView (python3-paraview, ~440 MB, installed here if missing) reads the XDMF of one small run
+# per problem; arrays and time steps compared with the runs' own files, one frame rendered each.
+check-paraview: setup
+	@command -v pvpython >/dev/null && command -v xvfb-run >/dev/null || $(APT) install -y python3-paraview xvfb xauth
+	$(PY) benchmarks/cross_version.py run --out $(OUT)/paraview-runs
+	$(PY) benchmarks/paraview_check.py $$(ls -d $(OUT)/paraview-runs/*/) --out $(OUT)/paraview-check
 
 clean:
 	rm -rf $(VENV) results .pytest_cache build *.egg-info
