@@ -137,7 +137,8 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
                "environment": io.environment(comm)}
     if comm.rank == 0:
         write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
-        plot_convergence(out / "convergence.png", rows, rates, ex.id, ref_n, ref_k, definition)
+        label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
+        plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k, definition)
         print((out / "errors.md").read_text(), flush=True)
     io.write_json(out / "summary.json", summary, comm)
     return summary
