@@ -39,11 +39,11 @@ for cmd in "make demo" "make test"; do
   dt=$((SECONDS - s)); load=$(cut -d' ' -f1-3 /proc/loadavg)
   echo "check-fresh: '$cmd' in a fresh $SUITE minbase root$([ "$AS_USER" = 1 ] && echo ' as a non-root sudoer' || true): exit $rc, ${dt} s (log $log)"
   tail -3 "$log" | sed 's/^/    /'
-  result+=("{\"command\": \"$cmd\", \"exit\": $rc, \"wall_time_s\": $dt, \"loadavg_after\": \"$load\", \"last_line\": $(tail -1 "$log" | python3 -c 'import json,sys; print(json.dumps(sys.stdin.read().strip()))')}")
+  result+=("{\"command\": \"$cmd\", \"exit\": $rc, \"wall_time_s\": $dt, \"loadavg_after\": \"$load\", \"last_line\": $( (grep -E "passed|failed|demo output" "$log" || tail -1 "$log") | tail -1 | python3 -c 'import json,sys; print(json.dumps(sys.stdin.read().strip()))')}")
 done
 commit=$(git -C "$repo" rev-parse --short HEAD)
 ( IFS=,; echo "{\"suite\": \"$SUITE\", \"as_user\": $AS_USER, \"commit\": \"$commit\", \"debootstrap_s\": $t_boot, \"commands\": [${result[*]}]}" ) \
   | python3 -m json.tool > "$OUT"
 echo "check-fresh: record in $OUT"
-[ "${KEEP_ROOT:-0}" = 1 ] || rm -rf "$root"
+[ "${KEEP_ROOT:-0}" = 1 ] || remove_root "$root"
 grep -q '"exit": [1-9]' "$OUT" && exit 1 || exit 0

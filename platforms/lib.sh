@@ -35,7 +35,7 @@ mirror() {
 bare_root() {
   local suite=$1 dir=$2 m
   m=$(mirror)
-  rm -rf "$dir"
+  remove_root "$dir"
   mkdir -p "$(dirname "$dir")"
   echo "platforms: debootstrap --variant=minbase $suite (mirror from /etc/apt) -> $dir" >&2
   debootstrap --variant=minbase "$suite" "$dir" "$m" >"$dir.debootstrap.log" 2>&1 ||
@@ -56,10 +56,27 @@ in_root() {
   local rc=0
   chroot "$dir" /usr/bin/env -i HOME=/root PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin \
       LANG=C.UTF-8 TERM=dumb /bin/bash -c "$*" || rc=$?
-  umount -R "$dir/dev" || umount -lR "$dir/dev" || true
-  umount -R "$dir/sys" || umount -lR "$dir/sys" || true
-  umount "$dir/proc" || umount -l "$dir/proc" || true
+  unmount_all "$dir"
   return $rc
+}
+
+# unmount_all DIR: every mount below DIR, deepest first (lazily when busy, e.g. a process still
+# holding /dev/shm).
+unmount_all() {
+  local m
+  for m in $(findmnt -rn -o TARGET | grep "^$1/" | sort -r); do
+    umount "$m" 2>/dev/null || umount -l "$m" 2>/dev/null || true
+  done
+}
+
+# remove_root DIR: rm -rf a root, but never while anything (the host's /dev, /sys!) is mounted in it.
+remove_root() {
+  unmount_all "$1"
+  if findmnt -rn -o TARGET | grep -q "^$1/"; then
+    echo "platforms: NOT removing $1: still mounted: $(findmnt -rn -o TARGET | grep "^$1/" | tr '\n' ' ')" >&2
+    return 1
+  fi
+  rm -rf "$1"
 }
 
 # stack_root SUITE: a cached root of SUITE with the suite's own FEniCSx stack; rebuilt when
