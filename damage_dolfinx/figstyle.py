@@ -313,10 +313,13 @@ def render_pair(npz_a, npz_b, png_a, png_b):
 
 
 def legend_below(ax, ncol=3):
-    """Legend under the axes (never over the mesh)."""
+    """Legend under the axes' x label (never over the mesh), at a fixed distance in points
+    whatever the axes' height."""
+    from matplotlib.transforms import offset_copy
     handles, labels = ax.get_legend_handles_labels()
     if handles:
-        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.11), ncol=ncol,
+        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=ncol,
+                  bbox_transform=offset_copy(ax.transAxes, fig=ax.figure, y=-34, units="points"),
                   fontsize=8, frameon=False)
 
 

@@ -184,7 +184,7 @@ body {{ font-family: "DejaVu Sans", sans-serif; max-width: 62em; margin: 2em aut
         line-height: 1.4; font-size: 11pt; padding: 0 1em; }}
 header.title {{ border-bottom: 2px solid #333; margin-bottom: 1em; }}
 header.title h1 {{ margin-bottom: 0.2em; }}
-img {{ max-width: 100%; max-height: 560px; width: auto; height: auto; }}
+img {{ max-width: 100%; max-height: 460px; width: auto; height: auto; }}
 figure {{ margin: 1em 0; break-inside: avoid; }}
 figure.n2 img {{ max-width: 49%; vertical-align: top; }}
 @media print {{ img {{ max-height: 11cm; }} }}
