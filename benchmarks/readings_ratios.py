@@ -2,6 +2,11 @@
 
     python benchmarks/readings_ratios.py TABLE FOLDER [FOLDER ...] [--column error_v_L2]
                                          [--exclude N,K ...]
+    python benchmarks/readings_ratios.py --summary
+
+``--summary``: one row per thesis table for the committed thesis-size studies,
+reference_output/convergence (default reading) and reference_output/convergence-literal (the
+literal reading, where the default differs), as in the table of issue 16.
 
 TABLE is a key of ../shared/thesis/tables.json (2.4, 2.5, 2.6, 2.7, 3.1, 3.2); each FOLDER holds
 a study's errors.csv (damage-dolfinx converge). Prints, per folder, a markdown block: the cells
@@ -48,7 +53,34 @@ def markdown(name: str, c: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: thesis table -> (study folder, cells left out of the statistics)
+STUDIES = {"2.4": ("2.2-ex2", []), "2.5": ("2.3-ex1", []), "2.6": ("2.4-ex1-tresca", []),
+           "2.7": ("2.4-ex1-coulomb", []), "3.1": ("3.1-ex1", [(32, 0.01)]), "3.2": ("3.2-ex1", [])}
+
+
+def summary(tables: dict) -> str:
+    ref = Path(__file__).resolve().parent / "reference_output"
+    lines = ["| thesis table | study | reading | ours / thesis per cell (min / median / max) | "
+             "fitted rate thesis / ours |", "|---|---|---|---|---|"]
+    for key, (folder, exclude) in STUDIES.items():
+        for sub in ("convergence", "convergence-literal"):
+            f = ref / sub / folder
+            if not (f / "errors.csv").is_file():
+                continue
+            reading = json.loads((f / "summary.json").read_text()).get("reading") or "literal"
+            c = compare(tables[key], f, "error", exclude)
+            note = " (n = 32, k = 0.01 misprint left out)" if exclude else ""
+            lines.append(f"| {key} | {sub}/{folder} | {reading} | {c['min']:.3g} / "
+                         f"{c['median']:.3g} / {c['max']:.3g}{note} | "
+                         f"{c['rate_thesis']:.2f} / {c['rate_ours']:.2f} |")
+    return "\n".join(lines) + "\n"
+
+
 if __name__ == "__main__":
+    import sys
+    if sys.argv[1:] == ["--summary"]:
+        print(summary(json.loads(TABLES.read_text())["tables"]))
+        sys.exit(0)
     p = argparse.ArgumentParser()
     p.add_argument("table")
     p.add_argument("folders", nargs="+")
