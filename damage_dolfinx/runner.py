@@ -160,9 +160,17 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     stepper = ex.build(comm, n, k, T, h, overrides, mesh_file)
     if (resume or checkpoint_every) and not stepper.checkpoint_supported:
         raise InputError(f"example {ex.id} does not support checkpoints")
+    supported = stepper.checkpoint_supported
+    try:
+        if supported:
+            stepper.checkpoint_state()
+    except InputError:  # a variant without checkpoints (2.3 memory_mode=sum)
+        if resume or checkpoint_every:
+            raise
+        supported = False
     N = stepper.num_steps
     write_every = write_every or max(1, N // 20)
-    checkpoints = stepper.checkpoint_supported and bool(checkpoint_every or checkpoint_seconds)
+    checkpoints = supported and bool(checkpoint_every or checkpoint_seconds)
 
     summary = {"schema": "damage-dolfinx/summary/v1", "example": ex.id, "title": ex.title,
                "section": ex.section, "status": "running", "parameters": params.as_dict(),
@@ -199,6 +207,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                       summary, comm)
 
     def save_checkpoint():
+        write_summary()  # first: the summary is never behind the checkpoint
         checkpoint.save(out, stepper.checkpoint_state(), {
             **settings, "step": stepper.n, "t": stepper.t, "mpi_size": comm.size,
             "wall_time_s": previous_wall + time.perf_counter() - wall_start,
@@ -218,7 +227,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         return state[0], state[1], int(state[2])
 
     def checkpoint_due(since_checkpoint) -> bool:
-        if not stepper.checkpoint_supported:
+        if not supported:
             return False
         if checkpoint_every:
             return stepper.n % checkpoint_every == 0
@@ -254,12 +263,12 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
 
     def interrupt(signum):
         name = signal.Signals(signum).name
-        if stepper.checkpoint_supported:
+        if supported:
             save_checkpoint()
         summary.update(status="interrupted", signal=name,
                        wall_time_s=previous_wall + time.perf_counter() - wall_start)
         write_summary()
-        kept = ("checkpoint written; --restart continues the run" if stepper.checkpoint_supported
+        kept = ("checkpoint written; --restart continues the run" if supported
                 else f"example {ex.id} has no checkpoints: the history and fields so far stay")
         raise RunInterrupted(signum, f"stopped by {name} after step {stepper.n} "
                                      f"(t = {stepper.t:.6g}): {kept}")
