@@ -258,6 +258,11 @@ def read_msh(comm, path, rank=0, gdim=2):
     return (out.mesh, out.cell_tags, out.facet_tags) if hasattr(out, "mesh") else out
 
 
+def bc_dofs(bc):
+    """Local (unrolled, i.e. scalar) dof indices of a DirichletBC, owned and ghost."""
+    return bc.dof_indices()[0]
+
+
 def dofs_in_cells(V):
     """Local dof (block) indices used by some local cell (a parallel submesh may carry ghost
     vertices attached to no local cell; their dofs are never assembled)."""

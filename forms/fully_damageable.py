@@ -69,6 +69,16 @@ def velocity_step_forms(v, w, v_old, u_old, zeta_new, zeta_old, rho, k, E, nu, m
     return a, (l if L is None else l + L)
 
 
+def velocity_matrix_parts(v, w, rho, k, E, nu, m_visc):
+    """(a_mass, a_visc(z)) with a(v, w) of (3.159) = a_mass + a_visc(zeta_n) for zeta_n in K^h
+    (there eta_*(zeta_n) = zeta_n): a_visc is LINEAR in z, so the matrix of (3.159) is
+    M_rho/k + sum_j zeta_n,j W_j, updated from the nodal zeta_n without re-assembly (3.3 module)."""
+    a_mass = rho / k * ufl.inner(v, w) * ufl.dx                    # (3.159) (rho v_n / k, w)_H
+    a_visc = lambda z: ufl.inner(z * B_plane_stress(eps(v), E, nu) / m_visc,  # noqa: E731
+                                 eps(w)) * ufl.dx                  # (3.159) (zeta A eps(v_n), eps(w))_Q
+    return a_mass, a_visc
+
+
 def implicit_velocity_residual(v, w, v_old, u_old, zeta_new, zeta_old, rho, k, E, nu, m_visc,
                                L_trunc, zeta_star, c_nu, gap, n, f_B, f_N, dsN, dsC):
     """F(v; w) of the G33 deviation: (3.159) with u_{n-1} replaced by u_{n-1} + k v_n in the

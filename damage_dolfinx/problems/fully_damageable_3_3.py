@@ -38,6 +38,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
+from petsc4py import PETSc
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
@@ -45,7 +46,7 @@ from .. import compat
 from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from ..forms.fully_damageable import (implicit_velocity_residual, total_stress,
-                                      velocity_step_forms)
+                                      velocity_matrix_parts, velocity_step_forms)
 from ..parameters import InputError
 from ..solvers import LinearSolver, NonlinearSolver
 from .base import ProblemData, TimeStepper
@@ -54,6 +55,13 @@ from .base import ProblemData, TimeStepper
 #: override with -mech_ksp_type / -mech_pc_type (e.g. hypre)
 MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
                  "ksp_max_it": 5000, "ksp_initial_guess_nonzero": True}
+
+#: issue 18 (per-step cost): the matrix of (3.159) from the nodal zeta_n by a precomputed sparse
+#: map instead of a re-assembly (serial; equal to round-off), and CG started from the linear
+#: extrapolation 2 v_{n-1} - v_{n-2} instead of v_{n-1} (same solution to rtol 1e-12, fewer
+#: iterations). Switches for benchmarks/step_profile_3_3.py, which times the step both ways.
+FAST_MATRIX = True
+VELOCITY_EXTRAPOLATION = True
 
 
 class FullyDamageableContact(TimeStepper):
@@ -71,6 +79,7 @@ class FullyDamageableContact(TimeStepper):
         self.c_nu, self.gap = float(x["c_nu"]), float(x.get("gap", 0.0))
         self.damage_active = bool(x.get("damage_active", True))
         self.elastic_term = x.get("elastic_term", "explicit")
+        self.extrapolate = VELOCITY_EXTRAPOLATION
         self.error_components = [("u", self.u, "L2"), ("zeta", self.zeta, "L2")]  # Cor. 3.3
 
         # (3.158): damage obstacle step, source phi_A(eps(u_{n-1}), eta_*(zeta_{n-1}))
@@ -91,8 +100,14 @@ class FullyDamageableContact(TimeStepper):
         w = ufl.TestFunction(V)
         if self.elastic_term == "explicit":
             a, l = velocity_step_forms(ufl.TrialFunction(V), w, *args)
-            self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context,
-                                     constant_matrix=False, defaults=MECH_DEFAULTS)
+            if self.comm.size == 1 and FAST_MATRIX:  # issue 18: no re-assembly per step
+                parts = velocity_matrix_parts(ufl.TrialFunction(V), w, args[4], args[5], p.E,
+                                              p.nu, self.m_visc)
+                self.mech = VelocitySolver(a, l, self.bcs, mech_prefix, self.context, V,
+                                           *parts, self.zeta)
+            else:
+                self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context,
+                                         constant_matrix=False, defaults=MECH_DEFAULTS)
         elif self.elastic_term == "implicit":  # G33 deviation
             F = implicit_velocity_residual(self.v, w, *args)
             self.mech = NonlinearSolver(F, self.v, self.bcs, mech_prefix, self.context)
@@ -108,7 +123,6 @@ class FullyDamageableContact(TimeStepper):
                              p.zeta_star)
         self._vm_expr = compat.expression(von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
-        self._v_sq = compat.form(ufl.inner(self.v, self.v) * ufl.dx)
         self.contact = ContactMonitor(V, tags, GAMMA_C, self.gap)
         self.probe = ZetaProbe(Z, data.builders.get("probe"))
         choice = x.get("initial_damage")
@@ -128,11 +142,16 @@ class FullyDamageableContact(TimeStepper):
         return {}
 
     def _advance(self) -> dict:
+        extrapolate = self.extrapolate and self.elastic_term == "explicit"
+        if extrapolate:  # CG start 2 v_{n-1} - v_{n-2} (the solution is the same to rtol)
+            v_guess = 2.0 * self.v.x.array - self.v_old.x.array
         self.u_old.x.array[:] = self.u.x.array
         self.v_old.x.array[:] = self.v.x.array
         self.zeta_old.x.array[:] = self.zeta.x.array
         damage_its = self._timed("damage", self.damage.solve) if self.damage else 0  # (3.158)
         if self.elastic_term == "explicit":
+            if extrapolate:
+                self.v.x.array[:] = v_guess
             mech_its = self._timed("velocity", self.mech.solve, self.v)            # (3.159)
             stats = {"damage_its": damage_its, "mech_its": mech_its}
         else:
@@ -180,7 +199,10 @@ class FullyDamageableContact(TimeStepper):
     # -- scalars and summary
     def scalars(self) -> dict:
         out = super().scalars()
-        out["v_L2"] = float(np.sqrt(abs(compat.assemble_scalar(self._v_sq, self.comm))))
+        M, y = self._norm_operators[0], self._norm_operators[-1]  # built by super().scalars()
+        v = compat.petsc_vec(self.v)
+        M.mult(v, y)
+        out["v_L2"] = float(np.sqrt(abs(v.dot(y))))  # = ||v||_L2: v^T M v, no assembly
         out.update(self.contact(self.u, self.t))
         out.update(self.probe(self.zeta, self.t, self.params.zeta_star))
         return out
@@ -332,3 +354,98 @@ class DamageProfiles:
         return {"profiles": {"x2": self.x2, "x1": self.x1.tolist(), "times": list(self.times),
                              "zeta": list(self.values), "last_t": t,
                              "last_zeta": self._values(zeta).tolist()}}
+
+
+# ---------------------------------------------------------------------------- fast matrix
+class ZetaLinearMatrix:
+    """The matrix of (3.159), A(zeta) = A_0 + sum_j zeta_j W_j (A_0 = rho/k M with the Dirichlet
+    rows, W_j = a_visc(phi_j) linear in zeta), as CSR values data_0 + G zeta: one sparse product
+    per step instead of a re-assembly (issue 18). G is built once from a few assemblies: the
+    zeta dofs get a distance-2 colouring, so each entry (p, q) of a_visc(indicator of a colour)
+    comes from the single dof of that colour in the closed neighbourhood of p. Serial only (in
+    parallel, rows owned here may get contributions from dofs this rank does not hold)."""
+
+    def __init__(self, A, V, a_mass, a_visc, zeta, bcs):
+        import scipy.sparse as sp
+        Z = zeta.function_space
+        bs = V.dofmap.index_map_bs
+        compat.assemble_matrix(A, compat.form(a_mass), bcs)             # rho/k M, bc rows
+        A.assemble()
+        self.indptr, self.indices, self.data0 = (a.copy() for a in A.getValuesCSR())
+        rows = np.repeat(np.arange(self.indptr.size - 1), np.diff(self.indptr))
+        cz, cv = compat.cell_dofs(Z), compat.cell_dofs(V)
+        z_of_v = np.empty(V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts, int)
+        z_of_v[cv.ravel()] = cz.ravel()                                 # P1: same vertex order
+        nz = zeta.x.array.size
+        cells = sp.csr_matrix((np.ones(cz.size), (np.repeat(np.arange(cz.shape[0]), cz.shape[1]),
+                                                  cz.ravel())), shape=(cz.shape[0], nz))
+        adj = (cells.T @ cells).tocsr()                                 # closed neighbourhoods
+        adj2 = (adj @ adj).tocsr()
+        colour = np.full(nz, -1)
+        for j in range(nz):                                             # greedy, distance 2
+            used, c = set(colour[adj2.indices[adj2.indptr[j]:adj2.indptr[j + 1]]].tolist()), 0
+            while c in used:
+                c += 1
+            colour[j] = c
+        ncol = colour.max() + 1
+        near = np.full((nz, ncol), -1)                                  # dof of colour c next to p
+        coo = adj.tocoo()
+        near[coo.row, colour[coo.col]] = coo.col
+        bc_dofs = np.zeros(self.indptr.size - 1, bool)
+        for bc in bcs:
+            bc_dofs[compat.bc_dofs(bc)] = True
+        keep = ~(bc_dofs[rows] | bc_dofs[self.indices])
+        z_row = z_of_v[rows // bs]
+        ind = fem.Function(Z)
+        a_ind = compat.form(a_visc(ind))
+        W = compat.create_matrix(a_ind)
+        G_rows, G_cols, G_vals = [], [], []
+        for c in range(ncol):
+            ind.x.array[:] = colour == c
+            W.zeroEntries()
+            compat.assemble_matrix(W, a_ind, [])
+            W.assemble()
+            ip, ix, val = W.getValuesCSR()
+            j = near[z_row, c]
+            if not (np.array_equal(ip, self.indptr) and np.array_equal(ix, self.indices)) or \
+                    np.any((val != 0) & (j < 0)):
+                raise RuntimeError("velocity matrix map: sparsity or colouring mismatch")
+            sel = keep & (j >= 0) & (val != 0)
+            G_rows.append(np.flatnonzero(sel)), G_cols.append(j[sel]), G_vals.append(val[sel])
+        W.destroy()
+        self.G = sp.csr_matrix((np.concatenate(G_vals), (np.concatenate(G_rows),
+                                                         np.concatenate(G_cols))),
+                               shape=(self.data0.size, nz))
+        self.colours, self._last = int(ncol), None
+        # the PETSc matrix shares its CSR value array: the update writes it in place
+        self.data = self.data0.copy()
+        self.mat = PETSc.Mat().createAIJWithArrays(A.getSize(), (self.indptr, self.indices,
+                                                                 self.data), comm=A.getComm())
+
+    def update(self, zeta_values) -> bool:
+        """A(zeta) into ``self.mat``; False (unchanged) when zeta is the one of the last update."""
+        if self._last is not None and np.array_equal(zeta_values, self._last):
+            return False
+        self._last = zeta_values.copy()
+        np.add(self.data0, self.G @ zeta_values, out=self.data)
+        self.mat.assemble()  # new object state: the preconditioner is rebuilt
+        return True
+
+
+class VelocitySolver(LinearSolver):
+    """LinearSolver of (3.159) whose matrix comes from ZetaLinearMatrix (serial)."""
+
+    def __init__(self, a, l, bcs, prefix, context, V, a_mass, a_visc, zeta):
+        super().__init__(a, l, bcs, prefix, context, constant_matrix=False,
+                         defaults=MECH_DEFAULTS)
+        self.zeta = zeta
+        self.fast = ZetaLinearMatrix(self.A, V, a_mass, a_visc, zeta, self.bcs)
+        self.A.destroy()
+        self.A = self.fast.mat
+        self.ksp.setOperators(self.A)
+
+    def assemble_matrix(self):
+        start = time.perf_counter()
+        self.fast.update(self.zeta.x.array)
+        self._assembled = True
+        self.timings["assemble_matrix"] += time.perf_counter() - start
