@@ -5,7 +5,8 @@ per-step changes, measured in ONE process so that the ratios hold on a loaded ma
     .venv/bin/python benchmarks/step_profile_3_3.py --example 3.3-ex1 --n 128 --k 0.001 --steps 10
 
 Two steppers of the same run are built: "before" (the velocity matrix re-assembled each step,
-CG started from v_{n-1}: FAST_MATRIX = VELOCITY_EXTRAPOLATION = False) and "after" (the defaults). They
+right-hand side assembled, CG started from v_{n-1}: FAST_MATRIX = FAST_RHS =
+VELOCITY_EXTRAPOLATION = False) and "after" (the defaults). They
 advance in alternating blocks of --block steps (each its own state, the same trajectory), after
 --warmup steps each. Each step is split into: the damage step (right-hand side assembly and
 bookkeeping / SNES), the velocity step (matrix, right-hand side, CG with
@@ -47,7 +48,7 @@ if args.example == "3.3-ex3" and args.h is None and args.n is None:
 
 
 def build(fast: bool):
-    fd.FAST_MATRIX = fd.VELOCITY_EXTRAPOLATION = fast
+    fd.FAST_MATRIX = fd.FAST_RHS = fd.VELOCITY_EXTRAPOLATION = fast
     ex = examples.get(args.example)
     k = args.k or ex.k
     s = ex.build(comm, n=args.n, h=args.h, k=k, T=k * (args.warmup + args.steps + 1))
@@ -137,6 +138,20 @@ def floors(stepper, repeat=200) -> dict:
     cg = (time.perf_counter() - start) / max(ksp.getIterationNumber(), 1)
     out = {"velocity_dofs": A.getSize()[0], "velocity_nnz": int(A.getInfo()["nz_used"]),
            "spmv_us": 1e6 * spmv, "cg_iteration_us": 1e6 * cg}
+    fast = getattr(stepper.mech, "fast", None)
+    if fast is not None:  # the sparse map when zeta HAS changed (the wrench keeps zeta = 1 early)
+        start = time.perf_counter()
+        for _ in range(20):
+            fast._last = None
+            fast.update(stepper.zeta.x.array)
+        out["matrix_map_update_us"] = 1e6 * (time.perf_counter() - start) / 20
+        R = compat.create_matrix(stepper.mech.a)
+        start = time.perf_counter()
+        for _ in range(5):
+            R.zeroEntries()
+            compat.assemble_matrix(R, stepper.mech.a, stepper.mech.bcs)
+            R.assemble()
+        out["matrix_reassembly_us"] = 1e6 * (time.perf_counter() - start) / 5
     if stepper.damage is not None:
         B = stepper.damage.A
         x, y = B.createVecRight(), B.createVecLeft()
@@ -187,6 +202,9 @@ print(f"{args.example} (h={args.h}, n={args.n}), k = {result['k']:.4g}, {args.st
 print(f"floor: {floor_us['velocity_dofs']} dofs, SpMV {floor_us['spmv_us']:.1f} us, one CG "
       f"iteration {floor_us['cg_iteration_us']:.1f} us, damage SpMV "
       f"{floor_us.get('damage_spmv_us', float('nan')):.1f} us")
+if "matrix_map_update_us" in floor_us:
+    print(f"velocity matrix with a changed zeta: sparse map {floor_us['matrix_map_update_us']:.0f} "
+          f"us, re-assembly {floor_us['matrix_reassembly_us']:.0f} us")
 print(f"{'ms per step':52s} {'before':>9s} {'after':>9s} {'ratio':>7s}")
 for key in sorted(set(b) | set(a)):
     print(f"{key:52s} {b.get(key, 0):9.4f} {a.get(key, 0):9.4f} "

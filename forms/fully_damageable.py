@@ -79,6 +79,17 @@ def velocity_matrix_parts(v, w, rho, k, E, nu, m_visc):
     return a_mass, a_visc
 
 
+def velocity_rhs_boundary(w, u_old, zeta_old, zeta_star, c_nu, gap, n, f_B, f_N, dsN, dsC):
+    """The part of l of (3.159) that is not a matrix times a nodal vector: -j(zeta_{n-1},
+    u_{n-1}, w) + <f_n, w>. With Phi_L = identity (L_trunc = inf) the rest of l is
+    rho/k M v_{n-1} - K_B(zeta_{n-1}) u_{n-1}, K_B(z) = m_visc a_visc(z) (3.3 module)."""
+    _, dsq = _measures(dsC)
+    p_c = damaged_contact_pressure(u_old, zeta_old, n, c_nu, gap, zeta_star)
+    l = -p_c * ufl.dot(w, n) * dsq                    # (3.159) j(zeta_{n-1}, u_{n-1}, w)
+    L = load(w, f_B, f_N, dsN)                        # (3.159) <f_n, w>
+    return l if L is None else l + L
+
+
 def implicit_velocity_residual(v, w, v_old, u_old, zeta_new, zeta_old, rho, k, E, nu, m_visc,
                                L_trunc, zeta_star, c_nu, gap, n, f_B, f_N, dsN, dsC):
     """F(v; w) of the G33 deviation: (3.159) with u_{n-1} replaced by u_{n-1} + k v_n in the

@@ -230,3 +230,26 @@ def test_fast_velocity_matrix_equals_reassembly():
         print(f"fast update vs re-assembly: relative difference {d:.1e}")
         assert d < 1e-13
     assert not s.mech.fast.update(s.zeta.x.array)  # same zeta: no update
+
+
+def test_fast_velocity_rhs_equals_assembly():
+    """Issue 18, Phi_L = identity (L_trunc = inf, the wrench): the right-hand side of (3.159)
+    as rho/k M v_{n-1} - K_B(zeta_{n-1}) u_{n-1} + assembled contact and load equals the
+    assembled l to round-off, with the contact term active."""
+    from damage_dolfinx.solvers import LinearSolver
+    if MPI.COMM_WORLD.size > 1:
+        pytest.skip("the sparse maps are serial; in parallel l is assembled")
+    params = _params().replace(L_trunc=float("inf"))
+    s = _run(FullyDamageableContact(_data(params, 0.01, 0.3, _square(6), traction=(5.0, -40.0))))
+    assert s.mech.rhs is not None and s.scalars()["penetration_max"] > 1e-4
+    rng = np.random.default_rng(2)
+    for _ in range(3):
+        s.zeta_old.x.array[:] = rng.uniform(params.zeta_star, 1.0, s.zeta.x.array.size)
+        s.u_old.x.array[:] = s.u.x.array * rng.uniform(0.5, 1.5, s.u.x.array.size)
+        s.v_old.x.array[:] = s.v.x.array * rng.uniform(0.5, 1.5, s.v.x.array.size)
+        s.mech.assemble_rhs()
+        fast = s.mech.b.array.copy()
+        LinearSolver.assemble_rhs(s.mech)
+        d = np.abs(fast - s.mech.b.array).max() / np.abs(s.mech.b.array).max()
+        print(f"fast right-hand side vs assembly: relative difference {d:.1e}")
+        assert d < 1e-13

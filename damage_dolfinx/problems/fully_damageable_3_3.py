@@ -46,7 +46,8 @@ from .. import compat
 from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from ..forms.fully_damageable import (implicit_velocity_residual, total_stress,
-                                      velocity_matrix_parts, velocity_step_forms)
+                                      velocity_matrix_parts, velocity_rhs_boundary,
+                                      velocity_step_forms)
 from ..parameters import InputError
 from ..solvers import LinearSolver, NonlinearSolver
 from .base import ProblemData, TimeStepper
@@ -61,6 +62,7 @@ MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_
 #: extrapolation 2 v_{n-1} - v_{n-2} instead of v_{n-1} (same solution to rtol 1e-12, fewer
 #: iterations). Switches for benchmarks/step_profile_3_3.py, which times the step both ways.
 FAST_MATRIX = True
+FAST_RHS = True
 VELOCITY_EXTRAPOLATION = True
 
 
@@ -103,8 +105,13 @@ class FullyDamageableContact(TimeStepper):
             if self.comm.size == 1 and FAST_MATRIX:  # issue 18: no re-assembly per step
                 parts = velocity_matrix_parts(ufl.TrialFunction(V), w, args[4], args[5], p.E,
                                               p.nu, self.m_visc)
+                rhs = None  # Phi_L = identity: l by the same sparse maps (clamped: g = 0)
+                if FAST_RHS and (p.L_trunc is None or math.isinf(p.L_trunc)):
+                    rhs = (velocity_rhs_boundary(w, self.u_old, self.zeta_old, p.zeta_star,
+                                                 *args[11:]), self.v_old, self.u_old,
+                           self.zeta_old, self.m_visc)
                 self.mech = VelocitySolver(a, l, self.bcs, mech_prefix, self.context, V,
-                                           *parts, self.zeta)
+                                           *parts, self.zeta, rhs)
             else:
                 self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context,
                                          constant_matrix=False, defaults=MECH_DEFAULTS)
@@ -427,22 +434,57 @@ class ZetaLinearMatrix:
         if self._last is not None and np.array_equal(zeta_values, self._last):
             return False
         self._last = zeta_values.copy()
-        np.add(self.data0, self.G @ zeta_values, out=self.data)
+        self.Gz = self.G @ zeta_values
+        np.add(self.data0, self.Gz, out=self.data)
         self.mat.assemble()  # new object state: the preconditioner is rebuilt
         return True
 
 
 class VelocitySolver(LinearSolver):
-    """LinearSolver of (3.159) whose matrix comes from ZetaLinearMatrix (serial)."""
+    """LinearSolver of (3.159) whose matrix comes from ZetaLinearMatrix (serial). With ``rhs`` =
+    (l_boundary, v_old, u_old, zeta_old, m_visc) (only for Phi_L = identity and homogeneous
+    Dirichlet data) the right-hand side is rho/k M v_{n-1} - m_visc a_visc(zeta_{n-1}) u_{n-1}
+    (two products with the same maps) plus the assembled boundary terms."""
 
-    def __init__(self, a, l, bcs, prefix, context, V, a_mass, a_visc, zeta):
+    def __init__(self, a, l, bcs, prefix, context, V, a_mass, a_visc, zeta, rhs=None):
         super().__init__(a, l, bcs, prefix, context, constant_matrix=False,
                          defaults=MECH_DEFAULTS)
         self.zeta = zeta
-        self.fast = ZetaLinearMatrix(self.A, V, a_mass, a_visc, zeta, self.bcs)
+        self.fast = f = ZetaLinearMatrix(self.A, V, a_mass, a_visc, zeta, self.bcs)
         self.A.destroy()
-        self.A = self.fast.mat
+        self.A = f.mat
         self.ksp.setOperators(self.A)
+        self.rhs = rhs
+        if rhs is not None:
+            self.l_boundary = compat.form(rhs[0])
+            self._el_data, self._el_zeta = np.zeros_like(f.data0), None
+            self.M, self.K = (PETSc.Mat().createAIJWithArrays(self.A.getSize(), (
+                f.indptr, f.indices, data), comm=self.A.getComm()) for data in (f.data0,
+                                                                               self._el_data))
+            self._tmp = self.b.duplicate()
+
+    def assemble_rhs(self):
+        if self.rhs is None:
+            return super().assemble_rhs()
+        start = time.perf_counter()
+        _, v_old, u_old, zeta_old, m_visc = self.rhs
+        z, f = zeta_old.x.array, self.fast
+        if self._el_zeta is None or not np.array_equal(z, self._el_zeta):
+            self._el_zeta = z.copy()
+            Gz = f.Gz if f._last is not None and np.array_equal(z, f._last) else f.G @ z
+            np.multiply(Gz, m_visc, out=self._el_data)                  # K_B(zeta_{n-1})
+            self.K.assemble()
+        with self.b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(self.b, self.l_boundary)                 # contact + load
+        self.M.mult(compat.petsc_vec(v_old), self._tmp)                 # rho/k M v_{n-1}
+        self.b.axpy(1.0, self._tmp)
+        self.K.mult(compat.petsc_vec(u_old), self._tmp)                 # K_B(zeta_{n-1}) u_{n-1}
+        self.b.axpy(-1.0, self._tmp)
+        compat.apply_lifting(self.b, self.a, self.bcs)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        compat.set_bc(self.b, self.bcs)
+        self.timings["assemble_rhs"] += time.perf_counter() - start
 
     def assemble_matrix(self):
         start = time.perf_counter()
