@@ -467,6 +467,10 @@ class VelocitySolver(LinearSolver):
                 f.indptr, f.indices, data), comm=self.A.getComm()) for data in (f.data0,
                                                                                self._el_data))
             self._tmp = self.b.duplicate()
+            self._tmp.set(1.0)  # homogeneous Dirichlet data (clamped): the lifting adds 0
+            compat.set_bc(self._tmp, self.bcs)
+            bc = np.concatenate([compat.bc_dofs(c) for c in self.bcs] + [np.zeros(0, int)])
+            self._lifting = bool(np.any(self._tmp.array[bc] != 0.0))
 
     def assemble_rhs(self):
         if self.rhs is None:
@@ -486,7 +490,8 @@ class VelocitySolver(LinearSolver):
         self.b.axpy(1.0, self._tmp)
         self.K.mult(compat.petsc_vec(u_old), self._tmp)                 # K_B(zeta_{n-1}) u_{n-1}
         self.b.axpy(-1.0, self._tmp)
-        compat.apply_lifting(self.b, self.a, self.bcs)
+        if self._lifting:
+            compat.apply_lifting(self.b, self.a, self.bcs)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         compat.set_bc(self.b, self.bcs)
         self.timings["assemble_rhs"] += time.perf_counter() - start
