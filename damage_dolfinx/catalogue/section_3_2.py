@@ -5,7 +5,7 @@ import math
 import numpy as np
 import ufl
 
-from ..examples import Example, Figure
+from ..examples import Example, Figure, Reading
 from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from ..parameters import ModelParameters
 from .section_2_2 import OMEGA_PD, RHO_UZAWA
@@ -25,6 +25,18 @@ def _params(g_fric, solver="newton"):
 def _on(axis, value):
     """Marker of the contact nodes on the line x_axis = value (history columns)."""
     return lambda X: np.isclose(X[axis], value, atol=1e-10)
+
+
+#: evidence candidate for Example 1 (issue 16, benchmarks/readings.md)
+EVIDENCE_EX1 = Reading(
+    overrides={"kappa": 0.003, "lam_u": 2000.0},
+    assumptions=[
+        "R1 (evidence candidate): kappa = 0.003 instead of kappa = 1 (line 3973): with kappa = 1 "
+        "the damage is smoothed over the whole square (zeta 0.81-0.83), the spatial error is "
+        "tiny and the error falls with k instead of n (Table 3.2 falls with n); no value of "
+        "the text supports 0.003 (Sections 2.1 Ex. 3 and 2.3 use 1e-2, lines 1131, 2157)",
+        "R2 (evidence candidate): lambda_u = 2000 instead of 1000 (line 3973): what (1.3) gives "
+        "without its factor 1/2 (lines 349, 365), or the Section 3.3 value (line 4438)"])
 
 
 def examples():
@@ -48,7 +60,7 @@ def examples():
     square = lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {  # noqa: E731
         GAMMA_D: side(0, 1.0), GAMMA_N: side(0, 0.0), GAMMA_C: side(1, 0.0)})
     ex1 = Example(
-        id="3.2-ex1", section="3.2",
+        id="3.2-ex1", section="3.2", readings={"evidence": EVIDENCE_EX1},
         title="unit square, traction (200,0)(e^t - 1) on {0}x[0,1], Tresca g = 5: convergence "
               "(Table 3.2)",
         params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
