@@ -173,6 +173,10 @@ def main(argv=None):
             os._exit(4)
         return 4
     except RunInterrupted as exc:
+        import signal
+        from .runner import STOP_SIGNALS
+        for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out
+            signal.signal(s, signal.SIG_IGN)
         if comm.rank == 0:
             print(f"damage-dolfinx: {exc}", file=sys.stderr, flush=True)
         return exc.exit_status

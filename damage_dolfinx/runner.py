@@ -76,23 +76,38 @@ class RunInterrupted(Exception):
 
 class StopSignals:
     """While active, STOP_SIGNALS only set ``signum`` (the runner stops collectively at the end
-    of the step); a second signal ends the process at once (the signal's default action)."""
+    of the step); a signal repeated ``FORCE_AFTER`` seconds later ends the process at once (the
+    signal's default action). Earlier repeats are the same request arriving twice (a scheduler
+    signals every process and mpirun forwards it too) and are ignored."""
+
+    FORCE_AFTER = 5.0
 
     def __enter__(self):
-        self.signum, self._previous = 0, {}
+        self.signum, self._previous, self._first = 0, {}, None
         if threading.current_thread() is threading.main_thread():
             self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
         return self
 
     def _handle(self, signum, frame):
-        if self.signum:
+        now = time.monotonic()
+        if self.signum and now - self._first >= self.FORCE_AFTER:
             signal.signal(signum, signal.SIG_DFL)
             os.kill(os.getpid(), signum)
-        self.signum = signum
+        if not self.signum:
+            self.signum, self._first = signum, now
 
     def __exit__(self, *exc):
         for s, handler in self._previous.items():
+            signal.signal(s, handler if not self.signum else self._late)
+
+    def _late(self, signum, frame):
+        """After a stop: a duplicate of the request is still ignored; a later signal gets the
+        handler that was there before the run."""
+        if time.monotonic() - self._first < self.FORCE_AFTER:
+            return
+        for s, handler in self._previous.items():
             signal.signal(s, handler)
+        os.kill(os.getpid(), signum)
 
 
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
