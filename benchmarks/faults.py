@@ -109,10 +109,11 @@ def wait_step(proc, out, step, timeout=300):
     return last_step(out)
 
 
-def kill(proc, sig=signal.SIGKILL, ranks_only=False):
-    """Signal the whole session (mpirun and its ranks), or only the ranks (what srun does)."""
+def kill(proc, sig=signal.SIGKILL, ranks_only=False, mpirun_only=False):
+    """Signal the whole session (mpirun and its ranks), only the ranks (what srun does), or
+    only mpirun (a user's `kill`)."""
     pids = subprocess.run(["pgrep", "-s", str(proc.pid)], capture_output=True,
-                          text=True).stdout.split()
+                          text=True).stdout.split() if not mpirun_only else [str(proc.pid)]
     for pid in pids:
         if ranks_only and int(pid) == proc.pid and len(pids) > 1:
             continue
@@ -223,7 +224,7 @@ def case_kill_in_checkpoint(t, out):
         p = start(args, part, 1, ["--checkpoint-every", "2", *again])
         while p[0].poll() is None:
             if tmp.exists() and (part / "checkpoint.npz").exists():
-                kill(p[0])
+                os.kill(p[0].pid, signal.SIGKILL)  # at once (no pgrep): the window is short
                 break
         code, msg, tb1 = finish(p)
         codes.add(code)
@@ -286,7 +287,7 @@ def case_signal(t, out, sig, np_, ranks_only, extra=(), env_extra=None, expect=N
     proc = subprocess.Popen(argv([*args, *BASE, *extra, "--out", folder], np_), env=env,
                             stdout=err, stderr=subprocess.STDOUT, start_new_session=True)
     at = wait_step(proc, folder, 300)
-    kill(proc, sig, ranks_only=ranks_only)
+    kill(proc, sig, ranks_only=ranks_only, mpirun_only=np_ > 1 and not ranks_only)
     code, msg, tb = finish((proc, err))
     what = kept(folder)
     code2, msg2, tb2 = run(args, folder, np_, [*extra, "--restart"])
@@ -429,8 +430,8 @@ def main():
     p.add_argument("--out", default="results/faults")
     p.add_argument("--kills", type=int, default=10)
     p.add_argument("--seed", type=int, default=20)
-    p.add_argument("--only", nargs="+", choices=("issue", "kill", "disk", "checkpoint", "signal",
-                                                  "double", "deleted"))
+    p.add_argument("--only", nargs="+", choices=("issue", "kill", "kill-checkpoint", "disk",
+                                                  "checkpoint", "signal", "double", "deleted"))
     p.add_argument("--problems", nargs="*", default=list(PROBLEMS))
     p.add_argument("--pythonpath", help="run the command line of another checkout (before/after)")
     a = p.parse_args()
@@ -472,8 +473,9 @@ def main():
         case_signal(t, out, signal.SIGTERM, 2, False, expect={1})
     if not only or "double" in only:
         case_double_and_restart(t, out)
-    if not only or "kill" in only:
+    if not only or "kill" in only or "kill-checkpoint" in only:
         case_kill_in_checkpoint(t, out)
+    if not only or "kill" in only:
         for problem in a.problems:
             for np_ in (1, 2):
                 case_kills(t, out, problem, np_, a.kills, rng)
