@@ -211,7 +211,7 @@ def test_fast_velocity_matrix_equals_reassembly():
     """Issue 18: the matrix of (3.159) updated from the nodal zeta_n by the precomputed sparse
     map equals the re-assembled one to round-off, Dirichlet rows included, for any zeta in K^h;
     an unchanged zeta leaves the matrix untouched."""
-    from damage_dolfinx.problems.fully_damageable_3_3 import VelocitySolver
+    from damage_dolfinx.zeta_linear import VelocitySolver
     s = FullyDamageableContact(_data(_params(), 0.01, 0.05, _square(6)))
     if MPI.COMM_WORLD.size > 1:
         pytest.skip("the sparse map is serial; in parallel the matrix is re-assembled")
