@@ -301,6 +301,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             write_fields()
             timed_figures()
         report(stepper.n, stepper.t, stats, scalars, force=True)
+        stop = None
         while stepper.n < N:
             start = time.perf_counter()
             stats = stepper.advance()
@@ -318,10 +319,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             timed_figures()
             report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
             if stop:
-                summary["status"] = stop
                 break
-        else:
-            summary["status"] = "completed"
+        status = stop or "completed"  # recorded last: a kill before the end leaves "running"
         if checkpoints and last_checkpoint["step"] != stepper.n:
             save_checkpoint()  # so that --restart with a larger T continues from here
         history.close()
@@ -347,7 +346,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         history.close()
         raise
     summary["timings_s"] = dict(getattr(stepper, "timings", {}))
-    summary["wall_time_s"] = previous_wall + time.perf_counter() - wall_start
+    summary.update(status=status, wall_time_s=previous_wall + time.perf_counter() - wall_start)
     write_summary()
     if comm.rank == 0 and progress:
         print(f"[{ex.id}] {summary['status']} at t = {stepper.t:.5g} after {stepper.n} steps in "
