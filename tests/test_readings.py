@@ -32,7 +32,7 @@ def test_reading_changes_only_what_it_lists():
         reading = ex.readings.get("evidence")
         if reading is None:
             continue
-        lit, ev = examples.get(ex_id, "literal"), examples.get(ex_id, "evidence")
+        lit, ev = ex.with_reading("literal"), ex.with_reading("evidence")
         changed = {k for k, v in ev.params.as_dict().items() if lit.params.as_dict()[k] != v}
         assert changed == set(reading.overrides), ex_id
         assert (ev.traction is lit.traction) == (reading.traction is None), ex_id
