@@ -44,12 +44,12 @@ def main():
     record = {"example": a.id, "n": a.n, "k": a.k}
 
     start = time.perf_counter()
-    subprocess.run(cli(base + ["--out", str(out / "full")]), env=ENV, check=True)
+    subprocess.run(cli(base + ["--overwrite", "--out", str(out / "full")]), env=ENV, check=True)
     record["uninterrupted_serial_s"] = round(time.perf_counter() - start, 1)
     steps = json.loads((out / "full" / "summary.json").read_text())["num_steps"]
 
     start = time.perf_counter()
-    proc = subprocess.Popen(cli(base + ["--checkpoint-every", "50", "--out", str(out / "part")], 2),
+    proc = subprocess.Popen(cli(base + ["--checkpoint-every", "50", "--overwrite", "--out", str(out / "part")], 2),
                             env=ENV, start_new_session=True)
     meta = out / "part" / "checkpoint.json"
     while proc.poll() is None:

@@ -31,7 +31,7 @@ def measure(example, n, np_, steps, out):
     k = examples.get(example).k
     cmd = [sys.executable, "-m", "damage_dolfinx.cli", "run", example, "--n", str(n),
            "--T", f"{steps * k:.12g}", "--k", f"{k:.12g}", "--no-figures", "--quiet",
-           "--checkpoint-seconds", "0", "--out", str(out)]
+           "--checkpoint-seconds", "0", "--overwrite", "--out", str(out)]
     if "stability_check" in examples.get(example).params.extra:  # a set-up cost, not per step
         cmd += ["--set", "stability_check=off"]
     if np_ > 1:
