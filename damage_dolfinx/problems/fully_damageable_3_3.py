@@ -78,7 +78,8 @@ class FullyDamageableContact(TimeStepper):
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
         self.u, self.u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
         self.v, self.v_old = fem.Function(V, name="v"), fem.Function(V, name="v_old")
-        self._v_older = [np.zeros_like(self.v.x.array) for _ in range(2)]  # v_{n-3}, v_{n-4}
+        # v_{n-3}, v_{n-4} of the CG start's extrapolation (checkpointed: a resume is exact)
+        self._v_older = [fem.Function(V, name=f"v_older{i}") for i in (3, 4)]
         self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
         self.k = data.time.k
         self.rho, self.m_visc = float(x["rho"]), float(x["m_visc"])
@@ -155,7 +156,7 @@ class FullyDamageableContact(TimeStepper):
     def _advance(self) -> dict:
         extrapolate = self.extrapolate and self.elastic_term == "explicit"
         if extrapolate:  # CG start: cubic extrapolation from v_{n-1}, ..., v_{n-4}
-            v3, v4 = self._v_older
+            v3, v4 = (f.x.array for f in self._v_older)
             v_guess = 4.0 * (self.v.x.array + v3) - 6.0 * self.v_old.x.array - v4
             v4[:] = v3
             v3[:] = self.v_old.x.array
@@ -174,6 +175,14 @@ class FullyDamageableContact(TimeStepper):
         self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array          # (3.160)
         self.profiles.sample(self.zeta, self.t)
         return stats
+
+    def checkpoint_state(self) -> dict:
+        """u, zeta, v and, for the CG start's extrapolation, v_{n-2}, v_{n-3}, v_{n-4}: without
+        them a resumed run starts its CG elsewhere and differs at the solver tolerance (2e-11)."""
+        state = super().checkpoint_state()
+        if self.extrapolate and self.elastic_term == "explicit":
+            state.update(v_old=self.v_old, v_older3=self._v_older[0], v_older4=self._v_older[1])
+        return state
 
     def _interpolate_zeta0(self):
         """Example 2 selects its initial damage with ``--set initial_damage=a|b``."""
