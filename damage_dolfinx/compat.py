@@ -6,6 +6,7 @@ file only. Nothing else in the package may call an API listed here directly.
 """
 from __future__ import annotations
 
+import inspect
 import logging
 
 import numpy as np
@@ -106,20 +107,19 @@ def assemble_matrix(A, a_form, bcs):
     fem.petsc.assemble_matrix(A, a_form, bcs=bcs)
 
 
+#: keyword of the lifting / Dirichlet scale factor: 'scale' up to 0.8, 'alpha' from 0.9 on
+#: (probed once here, not by catching TypeError on every call of these per-step functions)
+_SCALE_KEY = "alpha" if "alpha" in inspect.signature(fem.petsc.set_bc).parameters else "scale"
+
+
 def apply_lifting(b, a_form, bcs, x0=None, scale=1.0):
     """b -= scale * A (g - x0) on the columns of Dirichlet dofs ('scale' <= 0.8, 'alpha' >= 0.9)."""
-    x0s = [] if x0 is None else [x0]
-    try:
-        fem.petsc.apply_lifting(b, [a_form], bcs=[bcs], x0=x0s, alpha=scale)
-    except TypeError:  # 0.5-0.8: positional 'scale'
-        fem.petsc.apply_lifting(b, [a_form], [bcs], x0s, scale)
+    fem.petsc.apply_lifting(b, [a_form], [bcs], [] if x0 is None else [x0],
+                            **{_SCALE_KEY: scale})
 
 
 def set_bc(b, bcs, x0=None, scale=1.0):
-    try:
-        fem.petsc.set_bc(b, bcs, x0=x0, alpha=scale)
-    except TypeError:  # 0.5-0.8: 'scale'
-        fem.petsc.set_bc(b, bcs, x0, scale)
+    fem.petsc.set_bc(b, bcs, x0, **{_SCALE_KEY: scale})
 
 
 _FORM_OPTIONS_KEY = "jit_options" if "jit_options" in fem.form.__code__.co_varnames else "jit_params"
