@@ -9,11 +9,12 @@ from . import compat
 
 
 def clamped(V, facet_tags, tag):
-    """u = 0 on the facets tagged ``tag`` (no condition if there are none)."""
-    V.mesh.topology.create_connectivity(1, 2)
+    """u = 0 on the facets tagged ``tag`` (no condition if there are none); any dimension."""
+    tdim = V.mesh.topology.dim
+    V.mesh.topology.create_connectivity(tdim - 1, tdim)
     facets = facet_tags.indices[facet_tags.values == tag]
-    dofs = fem.locate_dofs_topological(V, 1, facets)
-    return fem.dirichletbc(np.zeros(2, dtype=compat.ScalarType), dofs, V)
+    dofs = fem.locate_dofs_topological(V, tdim - 1, facets)
+    return fem.dirichletbc(np.zeros(tdim, dtype=compat.ScalarType), dofs, V)
 
 
 def normal_component_zero(V, facet_tags, tag, tol=1e-10):

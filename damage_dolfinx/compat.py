@@ -71,7 +71,8 @@ def scalar_p1(msh):
 
 
 def vector_p1(msh):
-    return function_space(msh, "Lagrange", 1, (2,))
+    """P1 vectors with one component per space dimension (2 on every thesis mesh, 3 in 3-D)."""
+    return function_space(msh, "Lagrange", 1, (msh.topology.dim,))
 
 
 def scalar_dg0(msh):
@@ -79,7 +80,8 @@ def scalar_dg0(msh):
 
 
 def tensor_dg0(msh):
-    return function_space(msh, "DG", 0, (2, 2))
+    d = msh.topology.dim
+    return function_space(msh, "DG", 0, (d, d))
 
 
 # ---------------------------------------------------------------------------- vectors
@@ -177,6 +179,12 @@ def create_rectangle(comm, p0, p1, n, diagonal: str = "right"):
     return dmesh.create_rectangle(comm, [np.asarray(p0, float), np.asarray(p1, float)], list(n),
                                   dmesh.CellType.triangle,
                                   diagonal=getattr(dmesh.DiagonalType, diagonal))
+
+
+def create_box(comm, p0, p1, n):
+    """Structured box (p0, p1) with n = (nx, ny, nz) hexahedra, each cut into 6 tetrahedra."""
+    return dmesh.create_box(comm, [np.asarray(p0, float), np.asarray(p1, float)], list(n),
+                            dmesh.CellType.tetrahedron)
 
 
 def create_submesh(msh, dim, entities):

@@ -5,12 +5,12 @@ L_n(w) = (f_B(t_n), w) + (f_N(t_n), w)_{Gamma_N}.
 """
 import ufl
 
-from damage_dolfinx.constitutive import B_plane_stress, eps, eta_star
+from damage_dolfinx.constitutive import B, eps, eta_star
 
 
 def stress(u, zeta, E, nu, zeta_star):
-    """sigma = eta_*(zeta) B eps(u) (Section 2.1)."""
-    return eta_star(zeta, zeta_star) * B_plane_stress(eps(u), E, nu)
+    """sigma = eta_*(zeta) B eps(u) (Section 2.1); B of the mesh's dimension (plane stress in 2-D)."""
+    return eta_star(zeta, zeta_star) * B(eps(u), E, nu)
 
 
 def load(w, f_B, f_N, dsN):
