@@ -1,8 +1,9 @@
 """Checkpoint/restart of long runs, independent of the number of MPI ranks.
 
 A checkpoint is ``checkpoint.npz``: the stepper's state Functions, gathered on rank 0 and keyed
-by partition-independent dof positions, and its metadata (step, time, run settings; ``__meta__``,
-also copied to ``checkpoint.json`` for people and scripts). Generations: a new checkpoint is
+by partition-independent dof positions, small NumPy arrays of solver state (the same on every
+rank, e.g. whether a lagged factorisation is due for renewal), and its metadata (step, time, run
+settings; ``__meta__``, also copied to ``checkpoint.json`` for people and scripts). Generations: a new checkpoint is
 written completely to ``checkpoint.npz.tmp`` (fsync) before the previous one is renamed to
 ``checkpoint.prev.npz`` and the new one into place, so a run killed at any moment, or a full disk,
 leaves at least one complete checkpoint; a restart takes the newest readable one (``latest``:
@@ -66,6 +67,9 @@ def save(out, state: dict, meta: dict, comm=MPI.COMM_WORLD):
     out = Path(out)
     gathered = {}
     for name, f in state.items():
+        if isinstance(f, np.ndarray):  # solver state, the same on every rank
+            gathered[name] = np.array(f)
+            continue
         keys, vals = comm.gather(_owned_keys(f), root=0), comm.gather(_values(f), root=0)
         if comm.rank == 0:
             gathered[name + "__keys"], gathered[name] = np.concatenate(keys), np.concatenate(vals)
@@ -169,12 +173,15 @@ def _match(saved: np.ndarray, local: np.ndarray) -> np.ndarray:
 
 
 def load(path, state: dict):
-    """Set every Function of ``state`` from the checkpoint file ``path`` (from ``latest``; any
-    number of ranks)."""
+    """Set every Function (and NumPy array, in place) of ``state`` from the checkpoint file
+    ``path`` (from ``latest``; any number of ranks)."""
     data = np.load(path)
     for name, f in state.items():
         if name not in data:
             raise InputError(f"cannot restart: the checkpoint has no field {name!r}")
+        if isinstance(f, np.ndarray):
+            f[...] = data[name]
+            continue
         index = _match(data[name + "__keys"], _owned_keys(f))
         _values(f)[:] = data[name][index]
         f.x.scatter_forward()

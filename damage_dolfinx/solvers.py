@@ -157,6 +157,15 @@ class LinearSolver:
             self._fresh_pc_needed = True
         return its
 
+    def factorise_now(self):
+        """Assemble the matrix as the form reads it now and factorise it as the lagged
+        preconditioner of the next solves (a restart rebuilds the interrupted run's one)."""
+        self.assemble_matrix()
+        self.ksp.getPC().setReusePreconditioner(False)
+        self.ksp.setUp()
+        self._fresh_pc_needed = False
+        self.factorizations += 1
+
     def _ksp_solve(self, x) -> int:
         fresh = self._fresh_pc_needed or not self.lagged
         if self.lagged:
