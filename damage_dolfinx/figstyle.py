@@ -312,6 +312,142 @@ def render_pair(npz_a, npz_b, png_a, png_b):
     return render_saved(npz_a, png_a, limits), render_saved(npz_b, png_b, limits)
 
 
+# ---------------------------------------------------------------------------- setting figures
+LOAD_COLOURS = {"f_N": "tab:purple", "f_B": "tab:orange"}
+
+
+def inside_test(cells):
+    """``inside(points) -> bool array``: points inside the body whose triangles are ``cells``."""
+    import matplotlib.tri as mtri
+    pts, inverse = np.unique(np.round(np.asarray(cells).reshape(-1, 2), 10), axis=0,
+                             return_inverse=True)
+    finder = mtri.Triangulation(pts[:, 0], pts[:, 1], inverse.reshape(-1, 3)).get_trifinder()
+    return lambda p: finder(np.asarray(p)[:, 0], np.asarray(p)[:, 1]) >= 0
+
+
+def outward_normals(segs, inside, size):
+    """Unit normals of boundary segments (nseg, 2, 2) pointing out of the body."""
+    d = segs[:, 1] - segs[:, 0]
+    length = np.linalg.norm(d, axis=1)[:, None]
+    tangent = d / np.where(length > 0, length, 1)
+    normal = np.stack([tangent[:, 1], -tangent[:, 0]], 1)
+    probe = segs.mean(1) + 0.2 * size * normal
+    normal[inside(probe)] *= -1
+    return normal
+
+
+def thin_out(segs, spacing):
+    """About one segment per ``spacing`` of boundary length (markers, arrows)."""
+    length = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
+    return np.diff(np.floor(np.concatenate([[0.0], np.cumsum(length)]) / spacing)) > 0
+
+
+def support_hatch(segs, inside, size):
+    """Short oblique ticks on the outer side of boundary segments (the clamp / foundation
+    symbol), about one per 1.5 ``size`` of boundary length."""
+    segs = segs[thin_out(segs, 1.5 * size)]
+    normal = outward_normals(segs, inside, size)
+    tangent = np.stack([-normal[:, 1], normal[:, 0]], 1)
+    mid = segs.mean(1)
+    return np.stack([mid, mid + size * (normal - 0.6 * tangent)], 1)
+
+
+def traction_arrows(segs, vectors, inside, size):
+    """(tails, deltas) of arrows for a traction on boundary segments, lengths 3 ``size`` x
+    |f| / max |f|: a pull starts at the boundary and points away from the body, a push ends on
+    it, a mostly tangential (shear) load is drawn along the boundary, just outside it."""
+    vectors = np.asarray(vectors, float)
+    norm = np.linalg.norm(vectors, axis=1)
+    keep = norm > 1e-12 * max(norm.max(initial=0.0), 1e-300)
+    segs, vectors, norm = segs[keep], vectors[keep], norm[keep]
+    if not len(segs):
+        return np.zeros((0, 2)), np.zeros((0, 2))
+    deltas = 3 * size * vectors / norm.max()
+    mid, normal = segs.mean(1), outward_normals(segs, inside, size)
+    cos = np.einsum("ij,ij->i", vectors, normal) / norm
+    tails = np.where((cos > 0.5)[:, None], mid, mid - deltas)
+    shear = np.abs(cos) <= 0.5
+    tails[shear] = mid[shear] + 1.2 * size * normal[shear] - deltas[shear] / 2
+    return tails, deltas
+
+
+def spread(points, spacing):
+    """Indices of ``points`` keeping one per square of side ``spacing`` (the one nearest the
+    square's centre): evenly spread markers and arrows."""
+    points = np.asarray(points, float)
+    if not len(points):
+        return np.zeros(0, dtype=np.int64)
+    rel = (points - points.min(0)) / spacing
+    keys = np.floor(rel).astype(np.int64)
+    dist = np.linalg.norm(rel - keys - 0.5, axis=1)
+    order = np.lexsort((dist, keys[:, 1], keys[:, 0]))
+    _, first = np.unique(keys[order], axis=0, return_index=True)
+    return np.sort(order[first])
+
+
+def body_force_points(cells, spacing):
+    """Points of a regular grid of step ``spacing`` inside the body (where the body-force
+    arrows sit); for thin bodies that the grid misses, one cell centroid per square."""
+    cells = np.asarray(cells)
+    pts = cells.reshape(-1, 2)
+    lo, hi = pts.min(0), pts.max(0)
+    gx, gy = (np.arange(lo[i] + spacing / 2, hi[i], spacing) for i in range(2))
+    grid = np.stack([g.ravel() for g in np.meshgrid(gx, gy)], 1)
+    grid = grid[inside_test(cells)(grid)]
+    if len(grid) >= 4:
+        return grid
+    centroids = cells.mean(1)
+    return centroids[spread(centroids, spacing / 2)]
+
+
+def draw_arrows(ax, tails, deltas, colour, label, size):
+    if not len(tails):
+        return
+    for i, (p, d) in enumerate(zip(tails, deltas)):
+        ax.annotate("", xy=p + d, xytext=p, zorder=4,
+                    arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.1,
+                                    mutation_scale=8 + 4 * min(1.0, np.linalg.norm(d) / (3 * size))))
+    ax.plot([], [], color=colour, lw=1.1, marker=">", markersize=4, label=label)  # legend entry
+
+
+def draw_setting(ax, cells, parts, loads=(), note=""):
+    """A thesis setting figure: the undeformed mesh, boundary parts (``parts``: (segments,
+    colour, label, hatched)), load arrows (``loads``: ("f_N", segments, vectors, label) or
+    ("f_B", points, vectors, label)); frames the axes on body, markers and arrows; ``note``
+    (e.g. why a load is not drawn) goes under the legend."""
+    from matplotlib.collections import LineCollection, PolyCollection
+    cells = np.asarray(cells)
+    ax.add_collection(PolyCollection(cells, facecolors="none", edgecolors="0.6",
+                                     linewidths=0.3 if len(cells) > 3000 else 0.5))
+    size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
+    inside = inside_test(cells)
+    extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
+    for segs, colour, label, hatched in parts:
+        if segs.size == 0:
+            continue
+        ax.add_collection(LineCollection(segs, colors=colour, linewidths=2.2,
+                                         label=mathtext(label), zorder=3))
+        if hatched:
+            ax.add_collection(LineCollection(support_hatch(segs, inside, size), colors=colour,
+                                             linewidths=0.8, zorder=3))
+    for kind, where, vectors, label in loads:
+        where, vectors = np.asarray(where, float), np.asarray(vectors, float)
+        if kind == "f_N":
+            tails, deltas = traction_arrows(where, vectors, inside, size)
+        else:
+            norm = np.linalg.norm(vectors, axis=1)
+            deltas = 2.5 * size * vectors / max(norm.max(initial=0.0), 1e-300)
+            tails = where - deltas / 2
+        draw_arrows(ax, tails, deltas, LOAD_COLOURS[kind], label, size)
+        extent += [tails, tails + deltas]
+    _frame(ax, extent)
+    legend_below(ax, ncol=2)
+    if note:
+        ax.annotate(note, xy=(0.5, 0.0), xycoords="axes fraction", xytext=(0, -62),
+                    textcoords="offset points", ha="center", va="top", fontsize=7.5,
+                    color="0.3")
+
+
 def legend_below(ax, ncol=3):
     """Legend under the axes' x label (never over the mesh), at a fixed distance in points
     whatever the axes' height."""

@@ -171,56 +171,82 @@ def _run_zeta_star(png_path):
         return None
 
 
-def plot_mesh(geometry, path, title="", labels=None):
+def plot_mesh(geometry, path, title="", labels=None, loads=None):
     """The undeformed mesh with its tagged boundary parts (thesis 'setting' figures): Gamma_D
-    with clamp hatching, Gamma_C with the foundation drawn under it, the legend below the axes;
-    collective."""
+    with clamp hatching, Gamma_C with the foundation drawn under it, load arrows (``loads``
+    from :func:`setting_loads`: traction on the Gamma_N facets, body force inside), the legend
+    below the axes; collective."""
     from . import figstyle
+    from .geometries import GAMMA_N
     msh, tags = geometry.mesh, geometry.facet_tags
     xy = msh.comm.gather(compat.cell_vertex_coords(msh), root=0)
     parts = {}
-    for tag in (labels or {}):
+    for tag in set(labels or {}) | {GAMMA_N}:
         local = compat.facet_vertex_coords(msh, tags.indices[tags.values == tag])
         parts[tag] = msh.comm.gather(local, root=0)
     if msh.comm.rank != 0:
         return
-    from matplotlib.collections import LineCollection, PolyCollection
     cells = np.concatenate(xy)
-    fig, (ax,) = figstyle.new_figure(1, figstyle.data_aspect(cells), panel_width=5.0)
-    ax.add_collection(PolyCollection(cells, facecolors="none", edgecolors="0.6",
-                                     linewidths=0.3 if len(cells) > 3000 else 0.5))
-    size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
     styles = ("tab:red", "tab:blue", "tab:green")
-    for (tag, label), color in zip((labels or {}).items(), styles):
-        segs = np.concatenate(parts[tag])
-        if segs.size == 0:
+    drawn = [(np.concatenate(parts[tag]), colour, label, "clamp" in label or "contact" in label)
+             for (tag, label), colour in zip((labels or {}).items(), styles)]
+    arrows, notes = [], []
+    for kind, expr, constants, t_const, times in (loads or []):
+        diameter = max(np.ptp(cells.reshape(-1, 2), axis=0))
+        if kind == "f_N":  # about one arrow per 10 % of the body's size along Gamma_N
+            where = np.concatenate(parts[GAMMA_N])
+            facet = float(np.median(np.linalg.norm(where[:, 1] - where[:, 0], axis=1)))
+            where = where[figstyle.spread(where.mean(1), max(0.08 * diameter, 2 * facet))]
+        else:
+            where = figstyle.body_force_points(cells, 0.15 * diameter)
+        points = where.mean(1) if kind == "f_N" else where
+        try:
+            t, vectors = _strongest_load(expr, constants, t_const, times, points)
+        except Exception as exc:  # noqa: BLE001 -- a load UFL cannot evaluate pointwise
+            notes.append(f"${kind}$ not drawn ({type(exc).__name__})")
             continue
-        ax.add_collection(LineCollection(segs, colors=color, linewidths=2.2,
-                                         label=figstyle.mathtext(label), zorder=3))
-        if "clamp" in label or "contact" in label:  # hatch ticks outside the body
-            ax.add_collection(LineCollection(_hatch(segs, cells, size), colors=color,
-                                             linewidths=0.8, zorder=3))
-    figstyle._frame(ax, [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)])
-    figstyle.legend_below(ax)
+        if t is None:
+            continue
+        peak = float(np.max(np.linalg.norm(vectors, axis=1)))
+        name = "traction" if kind == "f_N" else "body force"
+        when = "constant" if t == "constant" else f"at $t$ = {t:.3g}"
+        arrows.append((kind, where, vectors, f"${kind}$ ({name}, {when}): max |${kind}$| = {peak:.3g}"))
+    fig, (ax,) = figstyle.new_figure(1, figstyle.data_aspect(cells), panel_width=5.0)
+    figstyle.draw_setting(ax, cells, drawn, arrows, note="; ".join(notes))
     figstyle.save(fig, path, title=figstyle.mathtext(title))
 
 
-def _hatch(segs, cells, size):
-    """Short oblique ticks on the outer side of boundary segments (support / foundation
-    symbol), about one per ``size`` of boundary length."""
-    import matplotlib.tri as mtri
-    length = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
-    keep = np.diff(np.floor(np.concatenate([[0.0], np.cumsum(length)]) / (1.5 * size))) > 0
-    segs, length = segs[keep], length[keep][:, None]
-    mid = segs.mean(1)
-    tangent = (segs[:, 1] - segs[:, 0]) / np.where(length > 0, length, 1)
-    normal = np.stack([tangent[:, 1], -tangent[:, 0]], 1)
-    pts, inverse = np.unique(np.round(cells.reshape(-1, 2), 10), axis=0, return_inverse=True)
-    tri = mtri.Triangulation(pts[:, 0], pts[:, 1], inverse.reshape(-1, 3))
-    probe = mid + 0.2 * size * normal  # inside the body -> flip to the outside
-    inside = tri.get_trifinder()(probe[:, 0], probe[:, 1]) >= 0
-    normal[inside] *= -1
-    return np.stack([mid, mid + size * (normal - 0.6 * tangent)], 1)
+def setting_loads(stepper, samples=40):
+    """The stepper's loads for its setting figure: [(kind, UFL vector, its constants,
+    time constant, sample times)] for f_B and f_N (:func:`plot_mesh` draws each at the sampled
+    time where it is largest). Collective (a problem's ``loads()`` may assemble)."""
+    from ufl.algorithms import extract_type
+    T = stepper.data.time.T
+    times = np.linspace(0.0, T, samples + 1)[1:]
+    out = []
+    for kind, expr in zip(("f_B", "f_N"), stepper.loads()):
+        if expr is not None:
+            constants = {c: np.asarray(c.value) for c in extract_type(expr, ufl.Constant)}
+            out.append((kind, expr, constants, stepper.t_const, times))
+    return out
+
+
+def _strongest_load(expr, constants, t_const, times, points):
+    """(t, values (npts, 2)) of the UFL vector ``expr`` at ``points`` for the time of
+    ``times`` where its largest value is largest (t = "constant" if that never changes);
+    (None, None) if it vanishes throughout."""
+    def values(t, pts):
+        mapping = {c: (float(t) if c is t_const else (v if v.shape else float(v)))
+                   for c, v in constants.items()}
+        return np.array([[float(expr[i](tuple(p), mapping)) for i in range(2)] for p in pts])
+
+    probe = points[::max(1, len(points) // 12)]  # the time is chosen on a dozen points
+    peaks = [float(np.max(np.linalg.norm(values(t, probe), axis=1))) if len(probe) else 0.0
+             for t in times]
+    if not peaks or max(peaks) == 0.0:
+        return None, None
+    t = float(times[len(peaks) - 1 - int(np.argmax(peaks[::-1]))])  # the last time of the peak
+    return ("constant" if max(peaks) - min(peaks) <= 1e-12 * max(peaks) else t), values(t, points)
 
 
 def _draw_outline(ax, xy):

@@ -97,3 +97,37 @@ def test_one_file_per_thesis_figure(name):
     files = {reproduce._figure_name(name, reproduce.Job(ex, v)) for v in vs}
     assert files == ({"figure_2_24.png", "figure_2_25.png"} if ex == "2.4-ex1"
                      else {"figure_3_17.png", "figure_3_18.png"})
+
+
+def test_setting_figure_draws_loads_and_supports(tmp_path, monkeypatch):
+    """Figure 2.19 (2.3-ex3): the load (0, -10) on the top face for t <= 0.5 is drawn as
+    arrows at t = 0.5 pushing on Gamma_N; Gamma_D and Gamma_C carry the support hatching."""
+    from mpi4py import MPI
+    seen = {}
+    draw = figstyle.draw_setting
+    monkeypatch.setattr(figstyle, "draw_setting",
+                        lambda ax, cells, parts, loads=(), note="": seen.update(
+                            parts=parts, loads=loads, note=note) or draw(ax, cells, parts, loads, note))
+    ex = examples.get("2.3-ex3")
+    stepper = ex.build(MPI.COMM_SELF, n=4)
+    fig = next(f for f in ex.figures if f.kind == "mesh")
+    runner.draw_figure(ex, fig, stepper, tmp_path)
+    assert (tmp_path / "figure_2_19.png").is_file() and not seen["note"]
+    (kind, segs, vectors, label), = seen["loads"]
+    assert kind == "f_N" and len(segs) >= 4 and np.allclose(vectors, [0.0, -10.0])
+    assert np.allclose(segs[:, :, 1], 1.0)                      # on the top face
+    assert "$t$ = 0.5" in label and "10" in label
+    hatched = {label.split()[0]: h for _, _, label, h in seen["parts"]}
+    assert hatched == {"Gamma_D": True, "Gamma_N": False, "Gamma_C": True}
+
+
+def test_traction_arrows_push_onto_and_pull_away_from_the_body():
+    square = np.array([[[0, 0], [1, 0], [1, 1]], [[0, 0], [1, 1], [0, 1]]], float)
+    inside = figstyle.inside_test(square)
+    right = np.array([[[1.0, 0.0], [1.0, 1.0]]])
+    tails, deltas = figstyle.traction_arrows(right, [[2.0, 0.0]], inside, 0.1)   # pull
+    assert np.allclose(tails, [[1.0, 0.5]]) and deltas[0, 0] > 0
+    tails, deltas = figstyle.traction_arrows(right, [[-2.0, 0.0]], inside, 0.1)  # push
+    assert np.allclose(tails + deltas, [[1.0, 0.5]]) and tails[0, 0] > 1.0
+    tails, deltas = figstyle.traction_arrows(right, [[0.0, 3.0]], inside, 0.1)   # shear: outside
+    assert np.all(tails[:, 0] > 1.0) and np.allclose(deltas, [[0.0, 0.3]])
