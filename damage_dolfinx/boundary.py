@@ -32,3 +32,26 @@ def normal_component_zero(V, facet_tags, tag, tol=1e-10):
         dofs = fem.locate_dofs_topological(V.sub(component), 1, facets[selected])
         bcs.append(fem.dirichletbc(compat.ScalarType(0.0), dofs, V.sub(component)))
     return bcs
+
+
+def bilateral_plane_faces(V, facet_tags, tag, tol=1e-10):
+    """u.nu = 0 on the tagged facets (bilateral contact / roller), any dimension; every tagged
+    facet must lie in a coordinate plane x_a = const (its component a is fixed). No condition
+    (an empty list) when no rank has such a facet. In 2-D this is ``normal_component_zero``."""
+    msh = V.mesh
+    facets = facet_tags.indices[facet_tags.values == tag]
+    if msh.comm.allreduce(facets.size) == 0:
+        return []
+    if msh.topology.dim == 2:
+        return normal_component_zero(V, facet_tags, tag, tol)
+    xyz = compat.facet_coords(msh, facets)
+    spread = xyz.max(axis=1) - xyz.min(axis=1)              # (facets, gdim)
+    size = spread.max(axis=1, keepdims=True)
+    in_plane = spread <= tol * (1.0 + size)                 # constant coordinate a
+    if not np.all(in_plane.sum(axis=1) == 1):
+        raise ValueError("bilateral contact is implemented on faces in coordinate planes only")
+    bcs = []
+    for a in range(msh.topology.dim):
+        dofs = fem.locate_dofs_topological(V.sub(a), msh.topology.dim - 1, facets[in_plane[:, a]])
+        bcs.append(fem.dirichletbc(compat.ScalarType(0.0), dofs, V.sub(a)))
+    return bcs

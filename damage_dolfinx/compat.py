@@ -278,6 +278,22 @@ def dofs_in_cells(V):
     return np.unique(dl.array if hasattr(dl, "array") else dl)
 
 
+def facet_coords(msh, facets):
+    """(len(facets), vertices per facet, gdim) coordinates of the given local facets' vertices
+    (any dimension; ``facet_vertex_coords`` is the 2-D form of the thesis meshes)."""
+    tdim, gdim = msh.topology.dim, msh.geometry.dim
+    facets = np.asarray(facets, dtype=np.int32)
+    if facets.size == 0:
+        return np.zeros((0, tdim, gdim))
+    msh.topology.create_connectivity(tdim - 1, tdim)
+    if hasattr(dmesh, "entities_to_geometry"):  # 0.7+
+        nodes = dmesh.entities_to_geometry(msh, tdim - 1, facets, False)
+    else:
+        cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))
+        nodes = dolfinx.cpp.mesh.entities_to_geometry(cpp_mesh, tdim - 1, facets, False)
+    return msh.geometry.x[nodes][:, :, :gdim]
+
+
 def facet_vertex_coords(msh, facets):
     """(len(facets), 2, 2) coordinates of the end points of the given local facets."""
     facets = np.asarray(facets, dtype=np.int32)

@@ -65,13 +65,15 @@ class DamageStep:
 
     def __init__(self, zeta: fem.Function, zeta_old: fem.Function, phi_old, k, kappa,
                  context: SolveContext, obstacle: bool, zeta_star: float = 0.01,
-                 prefix: str = "damage_"):
+                 prefix: str = "damage_", linear_defaults=None):
         V = zeta.function_space
         a, L = damage_step_forms(ufl.TrialFunction(V), ufl.TestFunction(V), zeta_old, phi_old,
                                  k, kappa)
         self.zeta, self.zeta_old, self.obstacle = zeta, zeta_old, obstacle
         if not obstacle:
-            self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True)
+            # linear_defaults: KSP options of the PDE form (None: direct; 3-D: scalable.py)
+            self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True,
+                                       defaults=linear_defaults)
             return
         self.a, self.L = compat.form(a), compat.form(L)
         self.A = compat.create_matrix(self.a)

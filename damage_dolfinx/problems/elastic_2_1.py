@@ -22,12 +22,12 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
-from .. import compat
+from .. import compat, scalable
 from ..damage import DamageStep, source
 from ..forms.elastic_damage import equilibrium_forms, stress
-from ..boundary import clamped
+from ..boundary import bilateral_plane_faces, clamped
 from ..constitutive import eps, von_mises
-from damage_dolfinx.geometries import GAMMA_D, GAMMA_N
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from ..solvers import LAGGED_DIRECT, LinearSolver
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
@@ -52,7 +52,7 @@ class ElasticDamage(TimeStepper):
         phi_old = source(eps(self.u), self.zeta_old, p)
         self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, self.k, self.kappa,
                                  self.context, obstacle=False, zeta_star=p.zeta_star,
-                                 prefix=damage_prefix)
+                                 prefix=damage_prefix, linear_defaults=scalable.damage_config(Z))
 
         # (2.21): elasticity with the new damage zeta_n
         tags = data.geometry.facet_tags
@@ -61,9 +61,14 @@ class ElasticDamage(TimeStepper):
         f_B, f_N = self.loads()
         a, L = equilibrium_forms(ufl.TrialFunction(V), w, self.zeta, p.E, p.nu, p.zeta_star,
                                  f_B, f_N, dsN)
-        bc = clamped(V, tags, GAMMA_D)
-        self.mech = LinearSolver(a, L, [bc], mech_prefix, self.context, defaults=LAGGED_DIRECT,
-                                 refactor_after_its=MECH_REFACTOR_ITS)
+        # Gamma_C, empty in every thesis example of 2.1, is read as bilateral contact u.nu = 0
+        # on coordinate-plane faces (rollers of the 3-D uniaxial-strain check, issue 17)
+        bcs = [clamped(V, tags, GAMMA_D)] + bilateral_plane_faces(V, tags, GAMMA_C)
+        # 2-D: lagged direct; 3-D: CG + AMG with the rigid-body near-nullspace (scalable.py)
+        defaults, refactor_its = scalable.mech_config(V, LAGGED_DIRECT, MECH_REFACTOR_ITS)
+        self.mech = LinearSolver(a, L, bcs, mech_prefix, self.context, defaults=defaults,
+                                 refactor_after_its=refactor_its)
+        scalable.prepare_mech(self.mech, V)
         # the damage the lagged factorisation was built from, and 1.0 when the next solve
         # factorises afresh anyway (checkpointed: a restart rebuilds the same preconditioner)
         self.zeta_pc = fem.Function(Z, name="zeta_pc")
