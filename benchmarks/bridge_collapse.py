@@ -60,42 +60,38 @@ def read_history(path):
 
 
 def plot_curve(P, d, summary, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    """Figure 2.7 (figstyle): our curve, the thesis's two failure loads as lines named in the
+    legend (no text over the curve), the collapse point."""
+    from damage_dolfinx import figstyle
+    pyplot = figstyle.plt()
+    fig, ax = pyplot.subplots(figsize=(6.4, 4.2))
     ax.plot(d, P, "o-", ms=3, label="damage model (this run)")
-    for key, style, label, va in (("damage_model_kN", "--", "thesis, damage model: 90 kN", "bottom"),
-                                  ("contact_model_kN", ":",
-                                   "thesis, contact model (40 interfaces): 87.14 kN", "top")):
-        ax.axhline(THESIS[key], ls=style, color="0.4", lw=1)
-        ax.text(d[0], THESIS[key], " " + label, va=va, fontsize=8, color="0.3")
+    for key, style, label in (("damage_model_kN", "--", "thesis, damage model"),
+                              ("contact_model_kN", ":", "thesis, contact model (40 interfaces)")):
+        ax.axhline(THESIS[key], ls=style, color="0.35", lw=1, label=f"{label}: {THESIS[key]:g} kN")
     if summary.get("failure_load_kN") is not None:
         ax.plot(d[-1], P[-1], "r*", ms=12,
                 label=f"collapse: {summary['failure_load_kN']:.4g} kN (step {summary['failure_step']})")
     ax.set_xlabel("downward displacement of the load patch [mm]")
-    ax.set_ylabel("quarter-span load P [kN per m]")
-    ax.set_title("2.1-ex3: force-displacement (thesis Fig. 2.7)")
+    ax.set_ylabel("quarter-span load $P$ [kN per m]")
     ax.set_ylim(bottom=0)
+    ax.grid(True, alpha=0.3)
     ax.legend(loc="lower right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    figstyle.save(fig, path, title="Example 2.1-3: force-displacement diagram (thesis Figure 2.7)")
 
 
 def plot_section_damage(summary, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     import numpy as np
+    from damage_dolfinx import figstyle
+    pyplot = figstyle.plt()
     D = np.asarray(summary["failure_section_damage"])
     n = D.size - 1
     angle = np.linspace(0.0, 180.0, n + 1)
     x_load = summary["bridge"]["x_load_m"]
     rc = 0.5 * (summary["bridge"]["r_in"] + summary["bridge"]["r_out"])
     load_angle = 180.0 - np.degrees(np.arccos(x_load / summary["bridge"]["r_out"]))
-    fig, ax = plt.subplots(figsize=(7.0, 3.6))
-    ax.plot(angle, D, "-", lw=1.2, label="section damage D_j")
+    fig, ax = pyplot.subplots(figsize=(7.0, 3.6))
+    ax.plot(angle, D, "-", lw=1.2, label="section damage $D_j$")
     hd = summary["hinge_definition"]
     ax.axhline(hd["min_height"], ls=":", color="0.5", lw=1, label="hinge threshold")
     for h in summary["hinges"]:
@@ -108,16 +104,13 @@ def plot_section_damage(summary, path):
                     textcoords="offset points", xytext=(0, 8), ha="center", fontsize=7)
     ax.axvline(load_angle, color="tab:green", lw=1, label=f"load (x = {x_load:.3g} m)")
     ax.set_xlabel(f"angle from the left springing [deg] (centre-line radius {rc:.4g} m)")
-    ax.set_ylabel("D_j = 1 - mean eta_*(zeta)")
+    ax.set_ylabel("$D_j = 1 - \\overline{\\eta_*(\\zeta)}$")
     ax.set_ylim(0, 1.15)
     ax.set_xlim(-16, 196)  # room for the labels of the springing hinges
     n_mech = summary.get("n_mechanism_hinges", len(summary["hinges"]))
-    ax.set_title(f"2.1-ex3 at collapse: {len(summary['hinges'])} damage peaks, {n_mech} hinges "
-                 "rotating (filled)", fontsize=10)
     ax.legend(loc="upper center", fontsize=7, ncol=3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    figstyle.save(fig, path, title=f"Example 2.1-3 at collapse: {len(summary['hinges'])} damage "
+                  f"peaks, {n_mech} hinges rotating (filled)")
 
 
 def write_outputs(out: Path, summary: dict):

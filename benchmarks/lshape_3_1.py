@@ -4,8 +4,9 @@
 
 Runs 3.1-ex3 twice (damage_active = 0, 1), prints the largest nodal displacement at T of both
 runs and its increase in %, the damage reached and the cost per step, and draws the two runs side
-by side: figure_3_7.png (deformed x10 with the initial outline, coloured by the von Mises norm of
-the strain) and figure_3_8.png (von Mises norm of eps(u_T) on the undeformed body). Default mesh
+by side (figstyle): figure_3_7.png (deformed mesh x10 over the initial outline, as the thesis
+caption says, line 3404) and figure_3_8.png (von Mises norm of eps(u_T) on the undeformed body,
+one colour scale for both panels). Default mesh
 h = 1/8 (coarse, about 30 s serial); the thesis mesh --h 0.03125 [G26] takes about 2 minutes
 (10 500 steps per run at k = 0.001: 3.5 ms/step frozen, 6.3 ms/step with damage). Writes
 lshape_3_1.json and the PNGs under --out (default results/lshape_3_1).
@@ -47,34 +48,22 @@ def run(h, k, T, active):
                 "k_max": st.stability.get("k_max"), "mesh": st.mesh_info()}
 
 
-def side_by_side(steppers, field_name, amplification, path, title, label):
-    """Two panels (undamaged, damaged) of a DG0 field on x + amplification u; collective."""
+def side_by_side(steppers, field_name, amplification, path, title, label, mesh_only=False):
+    """Two panels (undamaged, damaged) of a DG0 field on x + amplification u, on one colour
+    scale, or (``mesh_only``) their deformed meshes over the undeformed outline; drawn by
+    figstyle; collective."""
     panels = [post.gather_cells(st.u, getattr(st, field_name), amplification) for st in steppers]
     outline = post.gather_cells(None, steppers[0].zeta, 0.0)
     if COMM.rank != 0:
         return
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.tri as mtri
-    vmax = max(p[1].max() for p in panels)
-    fig, axes = plt.subplots(1, 2, figsize=(11.2, 4.8))
-    for ax, (xy, vals), name in zip(axes, panels, ("undamaged (zeta = 1)", "damaged")):
-        pts = xy.reshape(-1, 2)
-        tri = mtri.Triangulation(pts[:, 0], pts[:, 1], np.arange(pts.shape[0]).reshape(-1, 3))
-        edges = amplification and vals.size <= 2000  # mesh lines only where they stay visible
-        im = ax.tripcolor(tri, facecolors=vals, cmap="viridis", vmin=0.0, vmax=vmax,
-                          edgecolors="0.3" if edges else "none", linewidth=0.1)
-        post._draw_outline(ax, outline[0])
-        ax.set_aspect("equal")
-        ax.set_title(name)
-        ax.set_xlabel("x1 [m]")
-        ax.set_ylabel("x2 [m]")
-        fig.colorbar(im, ax=ax, shrink=0.85, label=label)
-    fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    from damage_dolfinx import figstyle
+    names = ("undamaged ($\\zeta$ = 1)", "damaged")
+    data = [{"xy": xy, "values": vals, "name": field_name, "label": label, "title": name}
+            for (xy, vals), name in zip(panels, names)]
+    scale = figstyle.shared_limits([vals for _, vals in panels])
+    figstyle.render_fields(data, path, title=title, amplification=amplification,
+                           ref_xy=outline[0] if amplification else None, mesh_only=mesh_only,
+                           limits={0: scale, 1: scale})
 
 
 def main():
@@ -95,9 +84,9 @@ def main():
     increase = 100.0 * (records[1]["u_max_T"] / records[0]["u_max_T"] - 1.0)
     title = f"3.1-ex3, h = {args.h:g}, k = {k:g}, t = {T:g}"
     side_by_side(steppers, "von_mises_strain", 10.0, out / "figure_3_7.png",
-                 f"{title}: deformed (x10) and initial outline", "von Mises norm of eps(u)")
+                 f"{title}: deformed mesh, undeformed outline dashed", "", mesh_only=True)
     side_by_side(steppers, "von_mises_strain", 0.0, out / "figure_3_8.png",
-                 f"{title}: von Mises norm of the strain", "von Mises norm of eps(u)")
+                 f"{title}: strains at the final time", "von Mises norm of the strain [-]")
     summary = {"h": args.h, "k": k, "T": T, "mpi_size": COMM.size, "runs": records,
                "u_max_increase_percent": increase,
                "expected_increase_percent_1_over_zeta": 100.0 * (1.0 / records[1]["zeta_mean"] - 1.0)}

@@ -9,7 +9,7 @@ is given. Reports the maximal interpenetration (u.nu)_+ between wrench and screw
 (value, time, location on the hexagon) and at T, compared with the largest displacement, and
 the von Mises and damage extremes at T. Writes under --out (default results/wrench_3_3): the run
 folder run/ (history.csv has penetration_max and its location per step; figures 3.19-3.22 of
-the catalogue), figure_3_20_mesh.png (deformed wire mesh x2 over the initial one),
+the catalogue), figure_3_20_mesh.png (deformed wire mesh x2 over the initial outline),
 penetration.png (max interpenetration vs t) and wrench.json.
 """
 import argparse
@@ -47,46 +47,32 @@ def default_k(h, T):
 
 
 def plot_deformed_mesh(stepper, amplification, path):
-    """Deformed wire mesh x amplification over the undeformed one (Figure 3.20); collective."""
+    """Deformed wire mesh x amplification over the undeformed outline (Figure 3.20, drawn by
+    figstyle, the factor rounded to 1-2-5 x 10^k if it is not); collective."""
+    from damage_dolfinx import figstyle
+    amplification = figstyle.drawn_amplification(amplification)
     deformed = post.gather_cells(stepper.u, stepper.zeta, amplification)
     initial = post.gather_cells(None, stepper.zeta, 0.0)
     if comm.rank != 0:
         return
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.collections import PolyCollection
-    fig, ax = plt.subplots(figsize=(6.4, 5.6))
-    ax.add_collection(PolyCollection(initial[0], facecolors="none", edgecolors="0.75",
-                                     linewidths=0.4, label="initial"))
-    ax.add_collection(PolyCollection(deformed[0], facecolors="none", edgecolors="tab:blue",
-                                     linewidths=0.5, label=f"deformed (x{amplification:g})"))
-    ax.autoscale()
-    ax.set_aspect("equal")
-    ax.set_xlabel("x1 [m]")
-    ax.set_ylabel("x2 [m]")
-    ax.legend(loc="upper right", fontsize=8)
-    ax.set_title(f"Example 3.3-3: deformed mesh (x{amplification:g}) at t = {stepper.t:.4g}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    panel = {"xy": deformed[0], "values": deformed[1], "name": "zeta", "label": "",
+             "title": "deformed mesh, undeformed outline dashed"}
+    figstyle.render_fields([panel], path, title=f"Example 3.3-3 at t = {stepper.t:.4g}",
+                           amplification=amplification, ref_xy=initial[0], mesh_only=True)
 
 
 def plot_penetration(history, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from damage_dolfinx import figstyle
+    pyplot = figstyle.plt()
     with open(history) as f:
         rows = list(csv.DictReader(f))
     t = [float(r["t"]) for r in rows]
-    fig, ax = plt.subplots(figsize=(6.4, 3.2))
+    fig, ax = pyplot.subplots(figsize=(6.4, 3.2))
     ax.plot(t, [float(r["penetration_max"]) for r in rows], lw=1.0)
-    ax.set_xlabel("t [s]")
-    ax.set_ylabel("max (u.nu)_+ on Gamma_C [m]")
+    ax.set_xlabel("$t$ [s]")
+    ax.set_ylabel("max $(u \\cdot \\nu)_+$ on $\\Gamma_C$ [m]")
     ax.grid(True, alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    figstyle.save(fig, path, title="Example 3.3-3: largest interpenetration wrench / screw")
 
 
 k_max = None

@@ -193,26 +193,23 @@ def write_tables(out, rows, ns, ks, rates, rates_T, example_id, ref_n, ref_k, de
 
 
 def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="error"):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    from . import figstyle
+    fig, ax = figstyle.plt().subplots(figsize=(6.4, 4.6))
     ks = sorted({r["k"] for r in rows}, reverse=True)
     for k in ks:
         sel = sorted((r for r in rows if r["k"] == k), key=lambda r: r["h_plus_k"])
         ax.loglog([r["h_plus_k"] for r in sel], [r["error"] for r in sel], "o-", ms=4,
-                  label=f"k = {k:g}")
+                  label=f"$k$ = {k:g}")
     hk = np.array([r["h_plus_k"] for r in rows])
     err = np.array([r["error"] for r in rows])
     p = rates["h_plus_k_all"]
     c = np.exp(np.mean(np.log(err) - p * np.log(hk)))
     xs = np.array([hk.min(), hk.max()])
     ax.loglog(xs, c * xs**p, "k--", label=f"fit: rate {p:.2f}")
-    ax.set_xlabel("h + k")
-    ax.set_ylabel(definition)
-    ax.set_title(f"{example_id}: convergence (reference n = {ref_n}, k = {ref_k:g})")
+    ax.set_xlabel("$h + k$")
+    ax.set_ylabel(figstyle.error_mathtext(definition))
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    figstyle.log_tick_labels(ax)
+    figstyle.save(fig, path, title=f"{example_id}: convergence (reference $n$ = {ref_n}, "
+                  f"$k$ = {ref_k:g})")

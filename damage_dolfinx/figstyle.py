@@ -60,6 +60,21 @@ def mathtext(label: str) -> str:
     return label
 
 
+def error_mathtext(definition: str) -> str:
+    """A convergence error definition (convergence.py) in mathtext:
+    'max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)' -> max_n (||u - u^hk||_V + ...)."""
+    greek = {"zeta": r"\zeta", "sigma": r"\sigma", "eta": r"\eta"}
+
+    def norm(m):
+        x = greek.get(m.group(1), m.group(1))
+        space = {"L2": "L^2"}.get(m.group(2), m.group(2))
+        return rf"\|{x} - {x}^{{hk}}\|_{{{space}}}"
+    text = re.sub(r"\|\|(\w+) - \1_hk\|\|_(\w+)", norm, definition)
+    if text == definition:
+        return mathtext(definition)
+    return "$" + text.replace("max_n", r"\max_n\,") + "$"
+
+
 # ---------------------------------------------------------------------------- amplification
 def round_amplification(a: float) -> float:
     """The largest factor of the 1-2-5 series (x 10^k) not above ``a`` (0 stays 0)."""
@@ -209,10 +224,12 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
                   mesh_only=False, limits=None):
     """Draw the panels of one figure. ``panels``: list of dicts with ``xy`` (nc, 3, 2) deformed
     triangles, ``values`` (nc, 3) P1 or (nc,) DG0, ``name`` and ``label``. ``limits``: optional
-    {panel index: (vmin, vmax)} (shared pair scales). Returns the colour limits used per panel
-    (None for a mesh-only panel)."""
+    {panel index: (vmin, vmax)} (shared pair scales). A panel's optional ``title`` replaces the
+    default one; mesh-only figures draw one panel (the fields share the deformed body) unless
+    every panel has a title (distinct bodies, e.g. undamaged and damaged runs side by side).
+    Returns the colour limits used per panel (None for a mesh-only panel)."""
     pyplot = plt()
-    nplot = 1 if mesh_only else len(panels)
+    nplot = len(panels) if not mesh_only or all("title" in p for p in panels) else 1
     allxy = [p["xy"] for p in panels] + ([ref_xy] if ref_xy is not None else [])
     fig, axes = new_figure(nplot, data_aspect(np.concatenate([np.asarray(x).reshape(-1, 2)
                                                                for x in allxy])))
@@ -222,7 +239,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
         xy, vals = np.asarray(p["xy"]), np.asarray(p["values"])
         if mesh_only:
             draw_mesh_edges(ax, xy)
-            ax.set_title("deformed mesh and undeformed outline (dashed)")
+            ax.set_title(p.get("title", "deformed mesh and undeformed outline (dashed)"))
             used.append(None)
         else:
             tri = _triangulation(xy)
@@ -245,10 +262,10 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
                 cb.formatter.set_powerlimits((-3, 4))
                 cb.update_ticks()
             if damage:
-                ax.set_title("damage $\\zeta$" + (f"\n{note}" if note else ""),
+                ax.set_title(p.get("title", "damage $\\zeta$") + (f"\n{note}" if note else ""),
                              color="firebrick" if note else "k")
             else:
-                ax.set_title(re.sub(r"\s*\[[^]]*\]$", "", label))
+                ax.set_title(p.get("title", re.sub(r"\s*\[[^]]*\]$", "", label)))
             used.append((vmin, vmax))
         if ref_xy is not None:
             draw_outline(ax, np.asarray(ref_xy))
@@ -446,6 +463,19 @@ def draw_setting(ax, cells, parts, loads=(), note=""):
         ax.annotate(note, xy=(0.5, 0.0), xycoords="axes fraction", xytext=(0, -62),
                     textcoords="offset points", ha="center", va="top", fontsize=7.5,
                     color="0.3")
+
+
+def log_tick_labels(ax):
+    """Label the 2 and 5 minor ticks of log axes spanning less than two decades (a log axis with
+    a single labelled power of ten cannot be read)."""
+    from matplotlib.ticker import FuncFormatter
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log" or lo <= 0 or math.log10(hi / lo) >= 2:
+            continue
+        axis.set_minor_formatter(FuncFormatter(
+            lambda v, _: f"{v:g}" if round(v / 10 ** math.floor(math.log10(v) + 1e-9)) in (2, 5)
+            else ""))
+        axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
 def legend_below(ax, ncol=3):

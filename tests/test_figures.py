@@ -131,3 +131,9 @@ def test_traction_arrows_push_onto_and_pull_away_from_the_body():
     assert np.allclose(tails + deltas, [[1.0, 0.5]]) and tails[0, 0] > 1.0
     tails, deltas = figstyle.traction_arrows(right, [[0.0, 3.0]], inside, 0.1)   # shear: outside
     assert np.all(tails[:, 0] > 1.0) and np.allclose(deltas, [[0.0, 0.3]])
+
+
+def test_convergence_error_label_in_mathtext():
+    assert figstyle.error_mathtext("max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)") == \
+        r"$\max_n\, (\|u - u^{hk}\|_{V} + \|\zeta - \zeta^{hk}\|_{L^2})$"
+    assert figstyle.mathtext("Gamma_D (clamped)") == r"$\Gamma_D$ (clamped)"
