@@ -133,12 +133,10 @@ def write_tables(rows, out: Path):
 
 
 def plot(rows, path):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
-    for ax, (study, key, label) in zip(axes, (("mesh", "h", "mesh size h [m]"),
-                                              ("time step", "k", "time step k [s]"),
+    from damage_dolfinx import figstyle
+    fig, axes = figstyle.plt().subplots(1, 3, figsize=(13, 3.8))
+    for ax, (study, key, label) in zip(axes, (("mesh", "h", "mesh size $h$ [m]"),
+                                              ("time step", "k", "time step $k$ [s]"),
                                               ("load rate", "load_rate", "load rate [kN/s]"))):
         sel = [r for r in rows if r["study"] == study and r["failure_load_kN"] is not None]
         x = [r[key] for r in sel]
@@ -156,10 +154,10 @@ def plot(rows, path):
         ax.set_xlabel(label)
         ax.set_ylabel("failure load [kN]")
         ax.set_title(f"vs {study}")
+        ax.grid(True, alpha=0.3)
     axes[0].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    figstyle.save(fig, path, title="Example 2.1-3: failure load against mesh, time step and "
+                  "load rate")
 
 
 def main():

@@ -137,3 +137,14 @@ def test_convergence_error_label_in_mathtext():
     assert figstyle.error_mathtext("max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)") == \
         r"$\max_n\, (\|u - u^{hk}\|_{V} + \|\zeta - \zeta^{hk}\|_{L^2})$"
     assert figstyle.mathtext("Gamma_D (clamped)") == r"$\Gamma_D$ (clamped)"
+
+
+def test_every_plot_goes_through_figstyle():
+    """No module draws with matplotlib directly: figure sizes, fonts, mathtext, colour scales and
+    layout come from figstyle (issue 19)."""
+    import re
+    files = list((REPO / "damage_dolfinx").rglob("*.py")) + list((REPO / "benchmarks").glob("*.py"))
+    direct = [p.name for p in files if p.name != "figstyle.py" and
+              re.search(r"^\s*(import matplotlib|from matplotlib)|\.savefig\(|plt\.subplots",
+                        p.read_text(), re.M)]
+    assert not direct, direct

@@ -42,6 +42,7 @@ def test_quick_figures_and_report(tmp_path):
     assert toc and set(toc) <= anchors
     assert re.search(r"\d+ reproduced, \d+ differ, \d+ not comparable", text)
     assert 'id="fig-2-14"' in text and "thesis lines" in text   # the produced figure, captioned
+    _damage_bars_fixed_and_factors_round(tmp_path / "figures", index)
     if CHROMIUM is None:
         pytest.skip("chromium not installed (make setup installs it)")
     loaded, total = _images_in_chromium(page)
@@ -50,6 +51,24 @@ def test_quick_figures_and_report(tmp_path):
     broken.write_text(page.read_text().replace("<body>", '<body><img src="missing.png">', 1))
     loaded, total = _images_in_chromium(broken)
     assert loaded == total - 1
+
+
+def _damage_bars_fixed_and_factors_round(out, index):
+    """Every field figure of a quick run: the damage colour bar, read back from the drawn
+    figure, spans [zeta*, 1] (or reaches below zeta* only where the field does); every
+    amplification factor in the index is round."""
+    from damage_dolfinx import figstyle
+    npzs = sorted((out / "runs").rglob("*" + figstyle.PANEL_SUFFIX))
+    assert npzs
+    for npz in npzs:
+        panels, meta, _ = figstyle.load_panels(npz)
+        used = figstyle.render_saved(npz, npz.with_suffix(".check.png"))
+        for panel, limits in zip(panels, used):
+            if figstyle.is_damage(panel["name"], panel["label"]):
+                lo = min(meta["zeta_star"], float(panel["values"].min()))
+                assert limits == (lo, max(1.0, float(panel["values"].max()))), npz
+    factors = [f["amplification"] for f in index["figures"] if f.get("amplification")]
+    assert factors and all(figstyle.is_round(a) for a in factors)
 
 
 def test_resumed_reproduction_keeps_completed_runs(tmp_path):
