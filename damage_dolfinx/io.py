@@ -3,9 +3,10 @@
 Everything is written incrementally: the XDMF file is re-opened in append mode for each output
 time and the CSV row is flushed after each step, so an interrupted run keeps every finished step.
 Only rank 0 writes CSV/JSON/NPZ; XDMF is collective. JSON and NPZ files are written to a temporary
-file and renamed (a kill never leaves a truncated file); the history is appended row by row (a
-full disk can truncate at most its last row, which a restart drops). A write that fails on any
-rank raises OutputError on every rank (``collective``), so ranks never wait for each other.
+file and renamed (atomic.py: a kill never leaves a truncated file); the history is appended row by
+row (a full disk can truncate at most its last row, which a restart drops). A write that fails on
+any rank raises OutputError on every rank (``atomic.collective``), so ranks never wait for each
+other. The run folder and its lock: runfolder.py.
 """
 from __future__ import annotations
 
@@ -14,12 +15,9 @@ import csv
 import ctypes
 import errno
 import io as _io
-import fcntl
-import json
 import os
 import platform
 import shutil
-import socket
 import sys
 import time
 from pathlib import Path
@@ -28,6 +26,8 @@ import numpy as np
 from mpi4py import MPI
 
 from . import compat
+from .atomic import (STUCK_SECONDS, OutputError, atomic_write_bytes, collective,  # noqa: F401
+                     describe, npz_writer, write_json)
 from .parameters import InputError
 
 
@@ -47,88 +47,6 @@ def prepare_output_dir(path, comm=MPI.COMM_WORLD) -> Path:
     if error:
         raise InputError(error)
     return path
-
-
-class OutputError(Exception):
-    """An output file could not be written (disk full, I/O error, folder deleted); one line."""
-
-
-def describe(exc: BaseException, folder=None) -> str:
-    """One line for an I/O exception (HDF5 reports a full disk only as 'Failed to close ...')."""
-    text = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc).splitlines()[0]
-    if folder is not None and not (isinstance(exc, OSError) and exc.errno == errno.ENOSPC):
-        try:
-            if shutil.disk_usage(folder).free < 1 << 16:
-                text += " (the disk is full)"
-        except OSError:
-            text += " (the output folder is gone)"
-    return text
-
-
-#: a rank whose write failed waits this long for the others, then aborts the job: a rank can
-#: be stuck for ever inside a collective HDF5 call that the failed rank left
-STUCK_SECONDS = 60.0
-
-
-def collective(comm, folder, what: str, fn, *args):
-    """Run the write ``fn(*args)`` on every rank; an OSError/RuntimeError on any rank raises
-    OutputError("cannot write WHAT: reason") on every rank (``what`` names file, step and time)."""
-    error = None
-    try:
-        fn(*args)
-    except (OSError, RuntimeError) as exc:
-        error = describe(exc, folder)
-    if comm.size > 1:
-        failed = np.zeros(comm.size, np.int32)
-        request = comm.Iallgather(np.array([error is not None], np.int32), failed)
-        deadline = time.monotonic() + STUCK_SECONDS
-        while not request.Test():
-            if error is not None and time.monotonic() > deadline:
-                print(f"damage-dolfinx: output error: cannot write {what}: {error} (another "
-                      "rank is stuck in the collective write: job aborted)", file=sys.stderr,
-                      flush=True)
-                comm.Abort(4)
-            time.sleep(0.001)
-        if failed.any():
-            error = comm.bcast(error, root=int(np.flatnonzero(failed)[0]))
-    if error:
-        raise OutputError(f"cannot write {what}: {error}")
-
-
-def atomic_write_bytes(path, write, fsync=False):
-    """Write a file through ``write(fileobj)`` into ``path.tmp`` and rename it onto ``path``;
-    the temporary file is removed if anything fails (so a full disk gets its space back)."""
-    path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        with open(tmp, "wb") as f:
-            write(f)
-            f.flush()
-            if fsync:
-                os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            tmp.unlink()
-        except OSError:
-            pass
-        raise
-
-
-def write_json(path, data, comm=MPI.COMM_WORLD):
-    """Atomically write ``data`` as JSON (rank 0; raises OSError there)."""
-    if comm.rank != 0:
-        return
-    text = json.dumps(data, indent=2, sort_keys=False, default=_json_default) + "\n"
-    atomic_write_bytes(path, lambda f: f.write(text.encode()))
-
-
-def _json_default(obj):
-    if isinstance(obj, (np.floating, np.integer)):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    return str(obj)
 
 
 def environment(comm=MPI.COMM_WORLD) -> dict:
@@ -308,7 +226,7 @@ def gather_dof_field(u):
     V = u.function_space
     n_owned = V.dofmap.index_map.size_local
     bs = V.dofmap.index_map_bs
-    coords = V.tabulate_dof_coordinates()[:n_owned, :2]
+    coords = V.tabulate_dof_coordinates()[:n_owned, :V.mesh.topology.dim]  # (N,2), 3-D: (N,3)
     values = u.x.array.reshape(-1, bs)[:n_owned]
     all_coords = V.mesh.comm.gather(coords, root=0)
     all_values = V.mesh.comm.gather(values, root=0)
@@ -317,7 +235,7 @@ def gather_dof_field(u):
     coords = np.concatenate(all_coords)
     values = np.concatenate(all_values)
     key = np.round(coords, 10)
-    order = np.lexsort((key[:, 1], key[:, 0]))
+    order = np.lexsort(key.T[::-1])  # by x, then y (then z)
     return coords[order], values[order]
 
 
@@ -330,88 +248,3 @@ def save_final_fields(path, functions: dict):
             data[name + "_coords"], data[name] = gathered
     if data:
         atomic_write_bytes(path, npz_writer(data))
-
-
-def npz_writer(arrays: dict):
-    """A ``write(fileobj)`` for atomic_write_bytes: the NPZ is built in memory, so a failed
-    write leaves no half-closed zip object behind (no 'Exception ignored' noise)."""
-    def write(f):
-        buffer = _io.BytesIO()
-        np.savez(buffer, **arrays)
-        f.write(buffer.getbuffer())
-    return write
-
-
-class RunLock:
-    """``out/.lock``, held (flock) by rank 0 of the live run; the kernel drops it when that
-    process dies, even by SIGKILL, so a dead run never blocks a new one. Raises InputError when
-    a live run holds it. Where the file system has no flock, a lock whose process is gone (same
-    host) is taken over. The file also reserves RESERVE bytes of disk that ``free_reserve``
-    gives back, so that a run stopped by a full disk can still record it in summary.json."""
-
-    RESERVE = 1 << 16
-
-    def __init__(self, out, comm=MPI.COMM_WORLD):
-        self.path, self.comm, self._fd = Path(out) / ".lock", comm, None
-        error = self._acquire() if comm.rank == 0 else None
-        error = comm.bcast(error, root=0)
-        if error:
-            raise InputError(error)
-
-    def _acquire(self):
-        for _ in range(10):  # the file may be replaced between open and flock (see release)
-            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                holder = os.read(fd, 1000).decode(errors="replace").split("\n")[0]
-                os.close(fd)
-                return f"a run is live in {str(self.path.parent)!r} ({holder or 'see .lock'}); " \
-                       f"wait for it to end or stop it (a dead run's lock is released at once)"
-            except OSError:  # no flock on this file system: the recorded process must be gone
-                holder = os.read(fd, 1000).decode(errors="replace").split()
-                if len(holder) >= 4 and _alive(holder[1], holder[3]):
-                    os.close(fd)
-                    return f"a run is live in {str(self.path.parent)!r} (pid {holder[1]})"
-            try:
-                same = os.fstat(fd).st_ino == os.stat(self.path).st_ino
-            except FileNotFoundError:
-                same = False
-            if same:
-                os.ftruncate(fd, 0)
-                self._header = (f"pid {os.getpid()} host {socket.gethostname()} since "
-                                f"{time.strftime('%Y-%m-%dT%H:%M:%S')}\n").encode()
-                try:
-                    os.pwrite(fd, self._header + b" " * self.RESERVE, 0)
-                except OSError:  # a nearly full disk: no reserve
-                    os.ftruncate(fd, 0)
-                    os.pwrite(fd, self._header, 0)
-                self._fd = fd
-                return None
-            os.close(fd)
-        return f"cannot lock {self.path}"
-
-    def free_reserve(self):
-        if self._fd is not None:
-            os.ftruncate(self._fd, len(self._header))
-
-    def release(self):
-        if self._fd is not None:
-            try:
-                self.path.unlink()  # before unlocking: a waiting opener then retries
-            except OSError:
-                pass
-            os.close(self._fd)
-            self._fd = None
-
-
-def _alive(pid, host) -> bool:
-    if host != socket.gethostname():
-        return True  # cannot tell: assume live
-    try:
-        os.kill(int(pid), 0)
-    except (ProcessLookupError, ValueError):
-        return False
-    except PermissionError:
-        return True
-    return True

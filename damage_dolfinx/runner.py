@@ -14,17 +14,14 @@ The file is rewritten (atomically) at every output time, so a killed run leaves 
 summary with status "running" and the CSV history of every finished step. Faults (README,
 Command line): a full disk or another output error stops the run with io.OutputError after
 marking the summary "failed" where space allows; SIGTERM/SIGINT/SIGUSR1 stop it at the end of
-the step with a checkpoint and status "interrupted" (RunInterrupted); io.RunLock refuses a
-second run into a folder where one is live.
+the step with a checkpoint and status "interrupted" (RunInterrupted, signals.py);
+runfolder.RunLock refuses a second run into a folder where one is live.
 """
 from __future__ import annotations
 
-import json
 import math
-import os
 import signal
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -34,6 +31,8 @@ from mpi4py import MPI
 from . import checkpoint, examples, io, post
 from .parameters import InputError
 from .geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from .runfolder import RunLock, previous_run, remove_run_files
+from .signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
 from .solvers import ConvergenceError
 
 
@@ -58,56 +57,6 @@ class Progress:
 
 #: default wall-time interval between checkpoints (seconds)
 CHECKPOINT_SECONDS = 120.0
-#: signals that stop a run at the end of the current step, with a checkpoint; mpirun (Open MPI)
-#: forwards SIGUSR1 to every rank, while it answers SIGTERM/SIGINT by killing the ranks
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1)
-#: files of a run that --overwrite removes (figures are overwritten by the new run)
-RUN_FILES = ("summary.json", "history.csv", "fields_final.npz", "checkpoint.json",
-             *checkpoint.GENERATIONS)
-
-
-class RunInterrupted(Exception):
-    """The run stopped on a signal after writing a checkpoint; exit status 128 + signal."""
-
-    def __init__(self, signum: int, message: str):
-        super().__init__(message)
-        self.signum, self.exit_status = signum, 128 + signum
-
-
-class StopSignals:
-    """While active, STOP_SIGNALS only set ``signum`` (the runner stops collectively at the end
-    of the step); a signal repeated ``FORCE_AFTER`` seconds later ends the process at once (the
-    signal's default action). Earlier repeats are the same request arriving twice (a scheduler
-    signals every process and mpirun forwards it too) and are ignored."""
-
-    FORCE_AFTER = 5.0
-
-    def __enter__(self):
-        self.signum, self._previous, self._first = 0, {}, None
-        if threading.current_thread() is threading.main_thread():
-            self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
-        return self
-
-    def _handle(self, signum, frame):
-        now = time.monotonic()
-        if self.signum and now - self._first >= self.FORCE_AFTER:
-            signal.signal(signum, signal.SIG_DFL)
-            os.kill(os.getpid(), signum)
-        if not self.signum:
-            self.signum, self._first = signum, now
-
-    def __exit__(self, *exc):
-        for s, handler in self._previous.items():
-            signal.signal(s, handler if not self.signum else self._late)
-
-    def _late(self, signum, frame):
-        """After a stop: a duplicate of the request is still ignored; a later signal gets the
-        handler that was there before the run."""
-        if time.monotonic() - self._first < self.FORCE_AFTER:
-            return
-        for s, handler in self._previous.items():
-            signal.signal(s, handler)
-        os.kill(os.getpid(), signum)
 
 
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
@@ -125,14 +74,14 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     completed run, otherwise a finished run is left as it is), keeping the history rows up to
     the checkpoint. A folder holding a run is refused (InputError) unless ``restart`` or
     ``overwrite`` (the command line passes overwrite=False unless --overwrite); a folder where a
-    run is live is always refused (io.RunLock). Output errors raise io.OutputError, signals
+    run is live is always refused (runfolder.RunLock). Output errors raise io.OutputError, signals
     RunInterrupted, both after recording the status in summary.json."""
     ex = examples.get(example_id, (overrides or {}).get("reading"))
     configured = ex.configure(n, k, T, h, overrides, mesh_file)
     if restart and not Path(out).is_dir():
         raise InputError(f"cannot restart: no checkpoint in {str(out)!r} (no such folder)")
     out = io.prepare_output_dir(out, comm)
-    lock = io.RunLock(out, comm)
+    lock = RunLock(out, comm)
     try:
         with StopSignals() as signals:
             return _run(ex, configured, out, n, k, T, h, overrides, write_every, progress,
@@ -148,7 +97,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     params, grid, n, h, mesh_file = configured
     settings = {"example": ex.id, "n": n, "h": h, "k": grid.k, "overrides": overrides or {},
                 "mesh_file": str(mesh_file) if mesh_file else None}
-    previous = _previous_run(out, comm)
+    previous = previous_run(out, comm)
     resume = None
     if restart:
         resume = checkpoint.resume_point(out, settings, grid, previous, comm)
@@ -164,7 +113,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         if not overwrite:
             raise InputError(f"{str(out)!r} holds {previous['description']}; --restart continues "
                              "it, --overwrite replaces it, or choose another --out")
-        io.collective(comm, out, f"(remove) the previous run in {out}", _remove_run_files, out,
+        io.collective(comm, out, f"(remove) the previous run in {out}", remove_run_files, out,
                       comm)
     path, resume = resume or (None, None)
     if resume:
@@ -354,34 +303,6 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     return summary
 
 
-def _previous_run(out, comm):
-    """The summary of a run already in ``out`` (with a 'description'), or None."""
-    result = None
-    if comm.rank == 0:
-        try:
-            result = json.loads((out / "summary.json").read_text())
-        except FileNotFoundError:
-            if any((out / name).exists() for name in checkpoint.GENERATIONS):
-                result = {"status": "running", "steps_done": "?"}
-        except (OSError, ValueError):
-            result = {"status": "unreadable", "steps_done": "?"}
-        if result is not None:
-            status = result.get("status")
-            kind = {"running": "an interrupted run", "interrupted": "an interrupted run",
-                    "failed": "a failed run"}.get(status, f"a finished run ({status})")
-            result["description"] = (f"{kind} of {result.get('example', '?')} "
-                                     f"({result.get('steps_done')} steps done)")
-    return comm.bcast(result, root=0)
-
-
-def _remove_run_files(out, comm):
-    if comm.rank == 0:
-        for path in [out / name for name in RUN_FILES] + list(out.glob("fields*.xdmf")) + \
-                list(out.glob("fields*.h5")) + list(out.glob("fields*.xdmf.bak")):
-            if path.exists():
-                path.unlink()
-
-
 def auto_amplification(stepper, diameter) -> float:
     """G40: the factor that makes the largest displacement 10% of the domain diameter."""
     u = stepper.u.x.array.reshape(-1, 2)
@@ -402,6 +323,13 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
             post.plot_damage_profiles(stepper.summary_extra()["profiles"], out / "history.csv",
                                       stepper.params.zeta_star, out / filename, fig.title)
         return {"file": filename}
+    if fig.kind == "slices":  # 3-D runs: fields on plane sections (issue 17, slices.py)
+        from .slices import plot_slices
+        planes = plot_slices([(stepper.von_mises, "von Mises stress [Pa]"),
+                              (stepper.zeta, "damage zeta [-]")], out / filename,
+                             title=f"{fig.title} (t = {stepper.t:.4g})",
+                             zeta_star=stepper.params.zeta_star)
+        return {"file": filename, "t": stepper.t, "sections": [list(p) for p in planes]}
     if fig.kind == "mesh":
         post.plot_mesh(stepper.data.geometry, out / filename, title=fig.title,
                        labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",
