@@ -2,9 +2,12 @@
 runs, corrupted checkpoints, a full disk (here a file-size limit, no root needed), signals, a
 double run. Every fault ends with one line and a documented exit status, nothing finished is
 lost, and resumed runs equal the uninterrupted run to 1e-12."""
+import builtins
+import errno
 import json
 import os
 import resource
+import shutil
 import signal
 import subprocess
 import sys
@@ -14,7 +17,7 @@ import numpy as np
 import pytest
 
 from conftest import ENV, load_run, rel_diff, run_cli
-from damage_dolfinx import cli, io
+from damage_dolfinx import atomic, cli, io
 
 RUN = ["run", "2.4-ex1", "--n", "8", "--k", "0.01", "--T", "0.6", "--no-figures", "--quiet"]
 #: long enough (1500 steps) to be stopped by a signal while it runs
@@ -128,6 +131,87 @@ def test_output_error_stops_the_run_and_restart_continues(tmp_path, reference):
     assert int(rows[-1]["step"]) == step and 0 < step < 60
     run_cli(RUN + ["--checkpoint-every", "10", "--write-every", "3", "--restart", "--out", out])
     assert _max_diff(out, reference) < 1e-12
+
+
+class _FailingDisk:
+    """Fault injection: the files whose name starts with ``name`` (their temporary files too)
+    that the output modules open get writes that fail with EIO (a failing disk) from the
+    ``after``-th write on, counted over all of them."""
+
+    def __init__(self, monkeypatch, name, after):
+        self.name, self.after, self.writes = name, after, 0
+        for module in (atomic, io):
+            monkeypatch.setattr(module, "open", self.open, raising=False)
+
+    def open(self, path, mode="r", *args, **kwargs):
+        f = builtins.open(path, mode, *args, **kwargs)
+        return _FailingFile(f, self) if os.path.basename(path).startswith(self.name) else f
+
+
+class _FailingFile:
+    def __init__(self, f, disk):
+        self._f, self._disk = f, disk
+
+    def write(self, data):
+        self._disk.writes += 1
+        if self._disk.writes >= self._disk.after:
+            raise OSError(errno.EIO, os.strerror(errno.EIO))
+        return self._f.write(data)
+
+    def __getattr__(self, name):
+        return getattr(self._f, name)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self._f.close()
+
+
+@pytest.mark.parametrize("name, after", [("history.csv", 25), ("checkpoint.npz", 3),
+                                         ("summary.json", 12)])
+def test_io_error_stops_the_run_and_restart_continues(tmp_path, capsys, monkeypatch, reference,
+                                                      name, after):
+    """EIO (injected) in the history, a checkpoint or the summary: exit status 4, one line
+    naming file and step; the finished steps and the last complete checkpoint stay, and
+    --restart (the disk repaired) ends equal to the uninterrupted run."""
+    out = tmp_path / "run"
+    with monkeypatch.context() as patch:
+        _FailingDisk(patch, name, after)
+        status, _, err = _main(RUN + ["--checkpoint-every", "10"], out, capsys)
+    assert status == 4 and err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"damage-dolfinx: output error: cannot write {name} at step "), err
+    assert err.rstrip().endswith(": Input/output error"), err
+    print(err.strip())
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == ("running" if name == "summary.json" else "failed")
+    assert not list(out.glob("*.tmp"))
+    status, _, err = _main(RUN + ["--checkpoint-every", "10", "--restart"], out, capsys)
+    assert status == 0, err
+    assert _max_diff(out, reference) < 1e-12
+
+
+@pytest.mark.parametrize("np_", [1, pytest.param(2, marks=pytest.mark.mpi)])
+def test_output_folder_deleted_mid_run(tmp_path, np_):
+    """The output folder removed while the run writes into it: one line, exit status 4."""
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "damage_dolfinx.cli", *LONG, "--write-every", "10",
+           "--out", str(out)]
+    if np_ > 1:
+        cmd = ["mpirun", "-n", str(np_), *cmd]
+    proc = subprocess.Popen(cmd, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True)
+    _wait_for_step(out, 20, proc)
+    while out.exists():  # files may appear while the tree is removed
+        shutil.rmtree(out, ignore_errors=True)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 4, err
+    ours = [line for line in err.splitlines() if line.startswith("damage-dolfinx:")]
+    assert len(ours) == 1 and "Traceback" not in err, err
+    assert ours[0].startswith("damage-dolfinx: output error: cannot write ") and \
+        " at step " in ours[0] and ("No such file or directory" in ours[0] or
+                                    ours[0].endswith(" (the output folder is gone)")), ours[0]
+    print(ours[0])
 
 
 @pytest.mark.parametrize("sig, np_", [(signal.SIGTERM, 1), (signal.SIGINT, 1),
