@@ -174,6 +174,26 @@ def interpolate(u: fem.Function, source):
     u.x.scatter_forward()
 
 
+def locate_points(msh, points):
+    """Index of a local cell (owned or ghost) containing each point of ``points`` (N, 3),
+    -1 where none does (``BoundingBoxTree`` + ``compute_collisions`` up to 0.8, ``bb_tree`` +
+    ``compute_collisions_points`` from 0.9 on)."""
+    import dolfinx.geometry as geo
+    points = np.ascontiguousarray(points, dtype=msh.geometry.x.dtype)
+    tdim = msh.topology.dim
+    if hasattr(geo, "bb_tree"):
+        candidates = geo.compute_collisions_points(geo.bb_tree(msh, tdim), points)
+    else:
+        candidates = geo.compute_collisions(geo.BoundingBoxTree(msh, tdim), points)
+    colliding = geo.compute_colliding_cells(msh, candidates, points)
+    cells = np.full(len(points), -1, dtype=np.int32)
+    for i in range(len(points)):
+        links = colliding.links(i)
+        if len(links):
+            cells[i] = links[0]
+    return cells
+
+
 # ---------------------------------------------------------------------------- meshes
 def create_rectangle(comm, p0, p1, n, diagonal: str = "right"):
     return dmesh.create_rectangle(comm, [np.asarray(p0, float), np.asarray(p1, float)], list(n),

@@ -30,6 +30,7 @@ class Figure:
     kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh),
     #                                        "history" (fields = ((column, label), ...) of history.csv)
     #                                        or "profiles" (summary "profiles" + zeta_probe, 3.3-ex2)
+    #                                        or "slices" (3-D: sections through the body, slices.py)
     times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
     mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
 
@@ -141,7 +142,7 @@ class Example:
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
 SECTIONS = ["section_2_1", "section_2_2", "section_2_3", "bridge", "section_2_4", "section_3_1",
-            "section_3_2", "section_3_3"]
+            "section_3_2", "section_3_3", "section_3d"]
 
 
 def catalogue(reading=None) -> dict:
