@@ -10,7 +10,8 @@ uninterrupted run of the same command (largest relative l2 difference over all s
 
 Cases: SIGKILL at --kills random steps of one run per problem (each kill resumed, serially and on
 2 ranks) and once during a checkpoint write; disk full (a tmpfs filled at a chosen step: needs
-root for `mount`) in the history, the checkpoint and the XDMF file; the output folder deleted;
+root for `mount`) in the history, the checkpoint and the XDMF file; an I/O error (EIO, injected
+into the writes of one file); the output folder deleted;
 truncated and zero-length checkpoints; SIGTERM, SIGINT, SIGUSR1 serially and on 2 ranks; a double
 run; a restart of a completed run (same and larger T); `run` into a finished folder. Writes
 faults.json and faults.md (the table of benchmarks/README.md) to --out.
@@ -39,11 +40,7 @@ PROBLEMS = {"2.1-ex1": ["--n", "10", "--k", "0.005", "--T", "1"],
             "3.1-ex1": ["--n", "8", "--k", "0.005", "--T", "1"],
             "3.2-ex1": ["--n", "8", "--k", "0.005", "--T", "1"],
             "3.3-ex1": ["--n", "8", "--k", "0.01", "--T", "1", "--set", "lam_u=1e6",
-                        "--set", "rho=1"],
-            # 2.1's elasticity is CG preconditioned by a lagged factorisation, rebuilt at every
-            # restart: the same run with a fresh factorisation per step isolates that effect
-            "2.1-ex1 fresh LU": ["--n", "10", "--k", "0.005", "--T", "1",
-                                 "-mech_ksp_type", "preonly"]}
+                        "--set", "rho=1"]}
 BASE = ["--no-figures", "--quiet"]
 LOGS = Path(".")
 #: the run of the disk, signal and restart cases: 2.4-ex1 (displacement, stress and damage state)
@@ -207,8 +204,8 @@ def case_kills(t, out, problem, np_, kills, rng):
         if tb:
             break
     code, msg, tb2 = run(args, part, np_, ["--checkpoint-every", "3", "--restart"])
-    t.add(f"kill-{problem}-np{np_}", f"SIGKILL at steps {killed} of {N} ({np_} rank(s)), each "
-          "resumed with --restart", sorted(statuses), "(killed: no message)", kept(part),
+    t.add(f"kill-{problem}-np{np_}", f"{problem}: SIGKILL at steps {killed} of {N} ({np_} "
+          "rank(s)), each resumed with --restart", sorted(statuses), "(killed: no message)", kept(part),
           fields_diff(part, ref) if code == 0 else None, expect=None, tb=tb or tb2,
           fail=code != 0)
 
@@ -318,6 +315,46 @@ def case_checkpoint_files(t, out):
         t.add(f"checkpoint-{how}", f"checkpoint.npz {how} ({size} -> "
               f"{size // 2 if how == 'truncated' else 0} bytes), then --restart", code, note,
               what, fields_diff(folder, ref) if code == 0 else None, expect={0}, tb=tb)
+
+
+#: the command line with the writes of files named ARGV[1]* failing with EIO from the ARGV[2]-th
+#: on (a failing disk; the same injection as tests/test_faults.py)
+EIO = """import builtins, errno, os, sys
+from damage_dolfinx import atomic, io
+name, after, count = sys.argv[1], int(sys.argv[2]), [0]
+class Failing:
+    def __init__(self, f): self._f = f
+    def write(self, data):
+        count[0] += 1
+        if count[0] >= after: raise OSError(errno.EIO, os.strerror(errno.EIO))
+        return self._f.write(data)
+    def __getattr__(self, attr): return getattr(self._f, attr)
+    def __enter__(self): return self
+    def __exit__(self, *exc): self._f.close()
+def fake_open(path, mode="r", *args, **kwargs):
+    f = builtins.open(path, mode, *args, **kwargs)
+    return Failing(f) if os.path.basename(path).startswith(name) else f
+atomic.open = io.open = fake_open
+from damage_dolfinx.cli import main
+sys.exit(main(sys.argv[3:]))
+"""
+
+
+def case_eio(t, out, name, after, extra):
+    """EIO in the writes of ``name`` (injected); then --restart without the fault."""
+    ref, folder = reference(out, RUN), out / f"eio_{name}"
+    err = open(log(folder), "a")
+    cmd = [sys.executable, "-c", EIO, name, str(after), "run", *RUN, *BASE, *extra,
+           "--out", str(folder)]
+    err.write(f"$ python -c EIO {name} {after} run {' '.join(RUN + extra)}\n")
+    err.flush()
+    code, msg, tb = finish((subprocess.Popen(cmd, env=ENV, stdout=err,
+                                             stderr=subprocess.STDOUT), err))
+    what = kept(folder)
+    code2, msg2, tb2 = run(RUN, folder, 1, [*extra, "--restart"])
+    t.add(f"eio-{name}", f"EIO writing {name} (injected, write {after} on), then --restart",
+          code, msg, what, fields_diff(folder, ref) if code2 == 0 else None, expect={4},
+          tb=tb or tb2, fail=f"cannot write {name}" not in msg or code2 != 0)
 
 
 def case_folder_deleted(t, out):
@@ -431,7 +468,8 @@ def main():
     p.add_argument("--kills", type=int, default=10)
     p.add_argument("--seed", type=int, default=20)
     p.add_argument("--only", nargs="+", choices=("issue", "kill", "kill-checkpoint", "disk",
-                                                  "checkpoint", "signal", "double", "deleted"))
+                                                  "checkpoint", "eio", "signal", "double",
+                                                  "deleted"))
     p.add_argument("--problems", nargs="*", default=list(PROBLEMS))
     p.add_argument("--pythonpath", help="run the command line of another checkout (before/after)")
     a = p.parse_args()
@@ -463,6 +501,9 @@ def main():
             _umount(mount)
     if not only or "checkpoint" in only:
         case_checkpoint_files(t, out)
+    if not only or "eio" in only:
+        for name, after in (("history.csv", 120), ("checkpoint.npz", 3), ("summary.json", 12)):
+            case_eio(t, out, name, after, ["--checkpoint-every", "50"])
     if not only or "deleted" in only:
         case_folder_deleted(t, out)
     if not only or "signal" in only:
