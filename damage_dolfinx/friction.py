@@ -41,9 +41,10 @@ from petsc4py import PETSc
 from . import compat
 from .constitutive import eps as strain
 from .contact import F_reg, NODAL_QUADRATURE, Phi_reg, tangent
+from .condensed import DiagonalUpdatePC, DiagonalUpdateSolver
 from .parameters import InputError
 from .solvers import (NEWTON, ConvergenceError, NonlinearSolver, SolveContext,
-                      set_default_options, spd_direct)
+                      replace_default_option, set_default_options, spd_direct)
 
 #: relative Jacobian shift on contact nodes (units of g per unit slip velocity)
 JACOBIAN_SHIFT = 1e-3
@@ -386,28 +387,14 @@ class PrimalDualActiveSet:
         compat.set_bc(free, self.p.bcs, scale=0.0)
         self.free_rows = free.array[self.rows] != 0.0
         free.destroy()
-        self.J = residual.A.duplicate(copy=True)
-        self.d = self.J.createVecLeft()
         self._r, self._rhs = residual.b.duplicate(), residual.b.duplicate()
-        self._last_d = None
-        set_default_options(prefix, spd_direct(comm))
-        self.ksp = PETSc.KSP().create(comm)
-        self.ksp.setOptionsPrefix(prefix)
-        self.ksp.setFromOptions()
+        # J = A + diag(K on the free tangential dofs): no factorisation per new K (issue 18)
+        self.solver = DiagonalUpdateSolver(residual.A, np.sort(self.rows[self.free_rows]), prefix)
+        self._order = np.argsort(self.rows[self.free_rows])
 
-    def _factorise(self, K):
-        """J = A + diag(K on the tangential dofs), refactorised only when K changed."""
-        self.d.set(0.0)
-        d = self.d.array
-        d[self.rows] = np.where(self.free_rows, K, 0.0)
-        comm = self.p.msh.comm
-        if self._last_d is not None and comm.allreduce(bool(np.array_equal(d, self._last_d)),
-                                                       op=MPI.LAND):
-            return
-        self.residual.A.copy(self.J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        self.J.setDiagonal(self.d, addv=PETSc.InsertMode.ADD_VALUES)
-        self.ksp.setOperators(self.J)
-        self._last_d = d.copy()
+    def solve_linear(self, K, b, x) -> bool:
+        """x = (A + diag(K on the tangential dofs))^{-1} b (direct); False if singular."""
+        return self.solver.solve(K[self.free_rows][self._order], b, x)
 
     def solve(self, x: PETSc.Vec, eps: float, rtol: float, atol: float, max_it: int) -> int:
         """Iterate from x (the previous velocity; lambda consistent with it) until ||F(x)|| <=
@@ -427,16 +414,14 @@ class PrimalDualActiveSet:
                 # with ``shift``, a proximal term shift g m (s_new - s) on the sliding nodes
                 # (zero at convergence) keeps the matrix regular when no Gamma_D holds the body
                 # and every node slides with a consistent multiplier (K = 0)
-                self._factorise(K + np.where(active, shift * gm, 0.0))
                 self.residual.b.copy(rhs)
                 nodes.add_tangential_load(rhs, np.where(active, g * (lam - shift * s), 0.0))
                 compat.set_bc(rhs, self.p.bcs)
-                self.ksp.solve(rhs, x)
-                if self.ksp.getConvergedReason() > 0:
+                if self.solve_linear(K + np.where(active, shift * gm, 0.0), rhs, x):
                     break
                 if shift > 0.0:
-                    raise ConvergenceError(f"primal-dual active set: linear solve failed "
-                                           f"(reason {self.ksp.getConvergedReason()})")
+                    raise ConvergenceError("primal-dual active set: linear solve failed "
+                                           "(singular matrix)")
                 shift = JACOBIAN_SHIFT
             s_new = nodes.tangential(x)
             lam = np.clip(np.where(active, sign + (1.0 - lam * sign) * (s_new - s) / size,
@@ -498,6 +483,11 @@ class RegularisedNewton:
         pdas = PrimalDualActiveSet(self.residual, prefix + "pdas_") if self.algebraic else None
         self.pdas = pdas if pdas is not None and pdas.usable else None
         self.pdas_iterations = self.pdas_solves = self.pdas_failures = 0
+        self.prefix = prefix
+        # Newton's linear solves by the active-set iteration's DiagonalUpdateSolver where the
+        # Jacobian is A + diag(K(stick set)) (checked): no assembly and no factorisation per
+        # new stick set (issue 18)
+        self.condensed = self.pdas is not None and self._condense_newton(J)
         newton_solve = self.newton.solve
 
         def solve_from_here():
@@ -510,8 +500,64 @@ class RegularisedNewton:
         self.solves = 0
         self.continuations = self.shifted_continuations = self.full_step_solves = 0
         self.fast_failures, self._fast_pause = 0, 0
-        self.prefix = prefix
         self.timings = {"solve": 0.0}
+
+    def _newton_K(self, x):
+        """The Jacobian's diagonal on the free tangential contact dofs at x: m g (1/eps on the
+        stick nodes |v_tau/eps| <= 1, as UFL differentiates clip, plus the shift)."""
+        eps = float(self.eps.value)
+        t = self.nodes.tangential(x) / eps
+        K = self.nodes.g * self.nodes.m * (np.where((t <= 1.0) & (t >= -1.0), 1.0 / eps, 0.0)
+                                           + float(self.shift.value))
+        return K[self.pdas.free_rows][self.pdas._order]
+
+    def _condense_newton(self, J) -> bool:
+        """Route the Newton KSP through a DiagonalUpdatePC with K = _newton_K(iterate), unless
+        the user chose the friction linear solver or the algebraic Jacobian differs from the
+        assembled UFL one (checked at a slipping and a stick/slip velocity, shift off and on)."""
+        comm, key = self.p.msh.comm, self.prefix + "pc_type"
+        if PETSc.Options().getString(key, "") != spd_direct(comm)["pc_type"]:
+            return False
+        if not self._jacobian_matches(J):
+            return False
+        pc = DiagonalUpdatePC(self.pdas.solver)
+        replace_default_option(key, "python")  # setFromOptions keeps the Python PC
+        snes = self.newton.snes.snes
+        pc.attach(snes.getKSP())
+        snes.setJacobian(lambda snes_, x, A_, P_: pc.set_K(self._newton_K(x)), pc.operator,
+                         pc.operator)
+        return True
+
+    def _jacobian_matches(self, J, rtol=1e-10) -> bool:
+        """True if the assembled UFL Jacobian equals A + diag(_newton_K) on every rank."""
+        v, A = self.p.v, self.residual.A
+        form = compat.form(J)
+        M = compat.create_matrix(form)
+        d = A.createVecLeft()
+        rows = np.sort(self.pdas.rows[self.pdas.free_rows])
+        saved = v.x.array.copy()
+        X = self.p.V.tabulate_dof_coordinates()[:, :2]
+        pattern = np.column_stack([np.sin(3.0 * X[:, 0] + 1.0) + np.cos(5.0 * X[:, 1]),
+                                   np.cos(2.0 * X[:, 0]) - np.sin(4.0 * X[:, 1] + 0.5)]).ravel()
+        worst = 0.0
+        for scale in (1.0, 2.0 * self.target):
+            for shift in (0.0, JACOBIAN_SHIFT):
+                v.x.array[:] = scale * pattern
+                self.shift.value = shift
+                M.zeroEntries()
+                compat.assemble_matrix(M, form, self.p.bcs)
+                M.assemble()
+                size = M.norm(PETSc.NormType.INFINITY)
+                d.set(0.0)
+                d.array[rows] = -self._newton_K(compat.petsc_vec(v))
+                M.axpy(-1.0, A, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+                M.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+                worst = max(worst, M.norm(PETSc.NormType.INFINITY) / max(size, 1e-300))
+        v.x.array[:] = saved
+        self.shift.value = 0.0
+        M.destroy()
+        d.destroy()
+        return self.p.msh.comm.allreduce(worst, op=MPI.MAX) <= rtol
 
     def use_form_residual(self):
         """Assemble the UFL residual in every Newton iteration (instead of AlgebraicResidual)."""

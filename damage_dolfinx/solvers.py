@@ -64,6 +64,14 @@ def set_default_options(prefix: str, defaults: dict):
             _CODE_DEFAULTS[name] = value
 
 
+def replace_default_option(name: str, value):
+    """Change one option this module put into the database (a user's option stays)."""
+    opts = PETSc.Options()
+    if name in _CODE_DEFAULTS or not opts.hasName(name):
+        opts[name] = value
+        _CODE_DEFAULTS[name] = value
+
+
 #: direct solve, factorisation reused while the matrix is unchanged
 DIRECT = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
