@@ -36,10 +36,10 @@ KEY_RESOLUTION = 1e-9
 
 
 def _owned_keys(f) -> np.ndarray:
-    """(n_owned_blocks, 2 or 4) partition-independent positions of f's owned dofs."""
+    """(n_owned_blocks, 2 or 4; 3 or 6 in 3-D) partition-independent positions of f's owned dofs."""
     V = f.function_space
     n_owned = V.dofmap.index_map.size_local
-    X = V.tabulate_dof_coordinates()[:n_owned, :2]
+    X = V.tabulate_dof_coordinates()[:n_owned, :V.mesh.topology.dim]  # 3-D: 3 coordinates
     if not compat.is_discontinuous(V):
         return X
     cell_dofs = compat.cell_dofs(V)
@@ -47,7 +47,7 @@ def _owned_keys(f) -> np.ndarray:
     flat = cell_dofs.reshape(-1)
     owned = flat < n_owned  # DG dofs of owned cells are owned
     dof_cell[flat[owned]] = np.repeat(np.arange(cell_dofs.shape[0]), cell_dofs.shape[1])[owned]
-    mid = compat.cell_midpoints(V.mesh)[dof_cell, :2]
+    mid = compat.cell_midpoints(V.mesh)[dof_cell, :V.mesh.topology.dim]
     return np.hstack([X, mid])
 
 
