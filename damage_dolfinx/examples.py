@@ -62,6 +62,7 @@ class Example:
     diameter: float
     n: Optional[int] = None          # structured meshes: cells per side
     h: Optional[float] = None        # gmsh meshes: element size
+    dim: int = 2                     # space dimension of the mesh (3: the issue-17 examples)
     body_force: Optional[Callable] = None
     traction: Optional[Callable] = None
     zeta0: object = 1.0

@@ -22,7 +22,7 @@ def examples():
         params=ModelParameters(E=1e4, nu=0.33, kappa=1.0, zeta_star=0.01, q_star=1000.0,
                                variant="B", lam_D=0.1, lam_w=0.0, stop_at_zeta_star=True,
                                lam_u_plus=1000.0, lam_u_minus=100.0),
-        T=1.0, k=0.02, n=10, diameter=5 * math.sqrt(3),
+        T=1.0, k=0.02, n=10, dim=3, diameter=5 * math.sqrt(3),
         make_geometry=lambda comm, n, h: box_with_hole(comm, n),
         make_stepper=ElasticDamage,
         body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t, 0.0)),
