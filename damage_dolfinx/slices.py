@@ -23,7 +23,11 @@ def sample_plane(fn, axis: int, value: float, lo, hi, res=RESOLUTION):
     x_axis = value over the box [lo, hi] (NaN outside the body); s, t are the coordinates of
     the two other axes (increasing). None on the other ranks."""
     a, b = [i for i in range(3) if i != axis]
-    s, t = np.linspace(lo[a], hi[a], res), np.linspace(lo[b], hi[b], res)
+    # pixel centres, shifted by different fractions in s and t so that no sample lies on a mesh
+    # face (grid planes, diagonals): a cell-wise field is two-valued there, and which cell is
+    # found first depends on the partition (serial and parallel figures would differ)
+    s = lo[a] + (np.arange(res) + 0.5137) * (hi[a] - lo[a]) / res
+    t = lo[b] + (np.arange(res) + 0.4729) * (hi[b] - lo[b]) / res
     S, T = np.meshgrid(s, t)
     points = np.zeros((S.size, 3))
     points[:, a], points[:, b], points[:, axis] = S.ravel(), T.ravel(), value
@@ -92,6 +96,8 @@ def plot_slices(fields, path, title="", zeta_star=0.01, planes=None, msh=None):
             a, b = [AXES[i] for i in range(3) if i != axis]
             image = ax.pcolormesh(s, t, np.ma.masked_invalid(v), cmap=cmap, vmin=vmin,
                                   vmax=vmax, shading="nearest")
+            ax.set_xlim(lo["xyz".index(a)], hi["xyz".index(a)])
+            ax.set_ylim(lo["xyz".index(b)], hi["xyz".index(b)])
             ax.set_aspect("equal")
             ax.set_xlabel(f"${a}$ [m]")
             ax.set_ylabel(f"${b}$ [m]")
