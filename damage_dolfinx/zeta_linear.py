@@ -73,15 +73,25 @@ class ZetaLinearMatrix:
                                                          np.concatenate(G_cols))),
                                shape=(self.data0.size, nz))
         self.colours, self._last = int(ncol), None
+        self._previous = (None, None)  # (zeta, G zeta) of the update before the last
         # the PETSc matrix shares its CSR value array: the update writes it in place
         self.data = self.data0.copy()
         self.mat = PETSc.Mat().createAIJWithArrays(A.getSize(), (self.indptr, self.indices,
                                                                  self.data), comm=A.getComm())
 
+    def product(self, zeta_values):
+        """G zeta, reused from the last two updates where zeta is theirs (the right-hand side
+        of step n needs G zeta_{n-1}, which the matrix update of step n-1 computed)."""
+        for last, Gz in ((self._last, getattr(self, "Gz", None)), self._previous):
+            if last is not None and np.array_equal(zeta_values, last):
+                return Gz
+        return self.G @ zeta_values
+
     def update(self, zeta_values) -> bool:
         """A(zeta) into ``self.mat``; False (unchanged) when zeta is the one of the last update."""
         if self._last is not None and np.array_equal(zeta_values, self._last):
             return False
+        self._previous = (self._last, getattr(self, "Gz", None))
         self._last = zeta_values.copy()
         self.Gz = self.G @ zeta_values
         np.add(self.data0, self.Gz, out=self.data)
@@ -124,7 +134,7 @@ class VelocitySolver(LinearSolver):
         z, f = zeta_old.x.array, self.fast
         if self._el_zeta is None or not np.array_equal(z, self._el_zeta):
             self._el_zeta = z.copy()
-            Gz = f.Gz if f._last is not None and np.array_equal(z, f._last) else f.G @ z
+            Gz = f.product(z)
             np.multiply(Gz, m_visc, out=self._el_data)                  # K_B(zeta_{n-1})
             self.K.assemble()
         with self.b.localForm() as bl:
