@@ -84,10 +84,8 @@ def main():
                      f"1e4): {fit_exponent([r for r in rows if r['ranks'] == ranks]):.2f}")
     (out / "scaling.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.6))
+    from damage_dolfinx import figstyle
+    fig, (a1, a2) = figstyle.plt().subplots(1, 2, figsize=(9, 3.6))
     for ranks in args.ranks:
         sel = [r for r in rows if r["ranks"] == ranks]
         d = [r["dofs_u"] for r in sel]
@@ -102,9 +100,8 @@ def main():
     a2.set_ylabel("CG iterations per solve (max)")
     a2.set_ylim(bottom=0)
     a2.legend(fontsize=7)
-    fig.suptitle("2.1-ex1-3d: CG + GAMG (elasticity), CG + BoomerAMG (damage)")
-    fig.tight_layout()
-    fig.savefig(out / "scaling.png", dpi=130)
+    figstyle.save(fig, out / "scaling.png",
+                  title="2.1-ex1-3d: CG + GAMG (elasticity), CG + BoomerAMG (damage)")
 
 
 if __name__ == "__main__":

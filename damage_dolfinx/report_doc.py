@@ -117,6 +117,17 @@ def _demote_headings(text) -> str:
     return re.sub(r"^(#+) ", lambda m: "#" * min(6, len(m.group(1)) + 3) + " ", text, flags=re.M)
 
 
+def _separator(line) -> bool:
+    cells = [c.strip() for c in line.strip().strip("|").split("|")]
+    return line.startswith("|") and all(c and set(c) <= set("-: ") for c in cells)
+
+
+def _table_start(lines, i) -> bool:
+    """A pipe table starts here: a '|' row followed by its delimiter row (as in GitHub
+    Markdown), so a wrapped line that begins with a norm '||u||' stays text."""
+    return lines[i].startswith("|") and i + 1 < len(lines) and _separator(lines[i + 1])
+
+
 def _markdown_to_html(text) -> str:
     """Headings, pipe tables, bullet lists, fenced code and paragraphs (consecutive lines
     joined) -- the subset our tables and benchmarks/readings.md use."""
@@ -129,7 +140,7 @@ def _markdown_to_html(text) -> str:
 
     while i < len(lines):
         line = lines[i]
-        if line.startswith("|"):
+        if _table_start(lines, i):
             flush()
             rows = []
             while i < len(lines) and lines[i].startswith("|"):
@@ -159,7 +170,8 @@ def _markdown_to_html(text) -> str:
             flush()
             items = [bullet.group(1)]
             i += 1
-            while i < len(lines) and lines[i].strip() and not lines[i].startswith(("|", "#")):
+            while i < len(lines) and lines[i].strip() and not lines[i].startswith("#") \
+                    and not _table_start(lines, i):
                 nxt = re.match(r"^\s*[-*] (.*)", lines[i])
                 if nxt:
                     items.append(nxt.group(1))

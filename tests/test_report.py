@@ -93,3 +93,12 @@ def test_resumed_reproduction_keeps_completed_runs(tmp_path):
     third = reproduce.run_figures("quick", out, np_=1, only=["2.3-ex1"], resume=True)
     assert "--restart" in third["runs"][0]["command"] and third["runs"][0]["returncode"] == 0
     assert json.loads(summary.read_text())["restarts"]  # went on from its (final) checkpoint
+
+
+def test_markdown_norm_at_line_start_is_text_not_a_table():
+    """benchmarks/readings.md wraps lines that begin with a norm ('||eps(u)||_L2 = ...'): a
+    pipe table needs its delimiter row, as in GitHub Markdown."""
+    from damage_dolfinx import report_doc
+    html = report_doc._markdown_to_html("a reading,\n||eps(u)||_L2 = 1e-3, so\n\n| n | k |\n"
+                                        "|---|--:|\n| 4 | 0.1 |\n")
+    assert html.count("<table>") == 1 and "<p>a reading, ||eps(u)||_L2 = 1e-3, so</p>" in html
