@@ -211,6 +211,11 @@ def plot_mesh(geometry, path, title="", labels=None, loads=None):
         name = "traction" if kind == "f_N" else "body force"
         when = "constant" if t == "constant" else f"at $t$ = {t:.3g}"
         arrows.append((kind, where, vectors, f"${kind}$ ({name}, {when}): max |${kind}$| = {peak:.3g}"))
+    if GAMMA_N in (labels or {}) and not notes:  # what Gamma_N carries, now that it is known
+        loaded = any(kind == "f_N" for kind, *_ in arrows)
+        drawn = [(segs, colour, f"Gamma_N ({'loaded' if loaded else 'traction-free'})"
+                  if label == labels[GAMMA_N] else label, hatched)
+                 for segs, colour, label, hatched in drawn]
     fig, (ax,) = figstyle.new_figure(1, figstyle.data_aspect(cells), panel_width=5.0)
     figstyle.draw_setting(ax, cells, drawn, arrows, note="; ".join(notes))
     figstyle.save(fig, path, title=figstyle.mathtext(title))
