@@ -52,3 +52,27 @@ def test_unknown_reading_is_refused(tmp_path, capsys, args):
     assert cli.main(args + ["--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
     assert "unknown reading 'bogus'" in err and err.count("\n") == 1
+
+
+def test_committed_studies_follow_the_default_readings():
+    """reference_output/convergence holds each example's thesis-size study in its default
+    reading, convergence-literal the literal one of exactly the examples whose default differs
+    (readings_ratios.py --summary and fidelity.py read them as such)."""
+    import json
+    from pathlib import Path
+    ref = Path(__file__).resolve().parents[1] / "benchmarks" / "reference_output"
+    catalogue = examples.catalogue()
+    evidence_default = {i for i, ex in catalogue.items()
+                        if ex.default_reading == "evidence" and ex.convergence}
+    literal_copies = set()
+    for sub in ("convergence", "convergence-literal"):
+        for summary in sorted((ref / sub).glob("*/summary.json")):
+            if summary.parent.name.endswith("-reduced"):
+                continue  # an older reduced-size study kept for comparison
+            s = json.loads(summary.read_text())
+            reading = s.get("reading") or "literal"
+            expected = catalogue[s["example"]].default_reading if sub == "convergence" else "literal"
+            assert reading == expected, summary
+            if sub == "convergence-literal":
+                literal_copies.add(s["example"])
+    assert literal_copies == evidence_default
