@@ -1,0 +1,140 @@
+"""Time per step of every problem against its floor at the same size (issue 18, item 1).
+
+    .venv/bin/python benchmarks/step_floor.py                    # ~4k dofs (n = 45), serial
+    .venv/bin/python benchmarks/step_floor.py --n 128 --only 3.2-ex1
+
+Each problem is built at --n (the wrench 3.3-ex3 at its thesis mesh h = 0.15, 1960 dofs) with
+the example's own k, advanced --warmup steps, then --steps steps are timed (wall and CPU; the
+stepper's own split, e.g. damage / velocity / friction, from its ``timings``). The floor is
+measured on the vector P1 matrix rho M + K_eps of the same mesh (the shape of every
+mechanical operator here): one sparse matrix-vector product (SpMV), one CG + Jacobi
+iteration, and one pair of triangular solves with its Cholesky factor (the solver the
+factorised schemes use), each the fastest of 5 blocks. Serial. Writes
+benchmarks/reference_output/step_floor/step_floor_n<N>.json and .md (--out to change).
+"""
+import argparse
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+import ufl
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from damage_dolfinx import compat, examples
+from damage_dolfinx.constitutive import eps
+
+PROBLEMS = ["2.1-ex1", "2.2-ex1", "2.3-ex1", "2.4-ex1", "3.1-ex1", "3.2-ex1", "3.3-ex1",
+            "3.3-ex3"]
+
+parser = argparse.ArgumentParser()
+parser.add_argument("--n", type=int, default=45, help="cells per side (45: about 4k dofs)")
+parser.add_argument("--steps", type=int, default=20)
+parser.add_argument("--warmup", type=int, default=2)
+parser.add_argument("--only", nargs="+")
+parser.add_argument("--out", default="benchmarks/reference_output/step_floor")
+parser.add_argument("--label", default="", help="suffix of the output files (e.g. before)")
+args = parser.parse_args()
+comm = MPI.COMM_WORLD
+if comm.size != 1:
+    raise SystemExit("step_floor.py is a serial profile")
+
+
+def _best(fn, repeat, blocks=5) -> float:
+    best = float("inf")
+    for _ in range(blocks):
+        start = time.perf_counter()
+        for _ in range(repeat):
+            fn()
+        best = min(best, (time.perf_counter() - start) / repeat)
+    return best
+
+
+def floors(V) -> dict:
+    """Microseconds: SpMV, one CG + Jacobi iteration and one Cholesky solve with M + K_eps."""
+    du, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+    a = compat.form(ufl.inner(du, w) * ufl.dx + ufl.inner(eps(du), eps(w)) * ufl.dx)
+    A = compat.create_matrix(a)
+    compat.assemble_matrix(A, a, [])
+    A.assemble()
+    x, y = A.createVecRight(), A.createVecLeft()
+    x.setRandom()
+    repeat = max(10, int(2e6 / A.getSize()[0]))
+    out = {"dofs": A.getSize()[0], "spmv_us": 1e6 * _best(lambda: A.mult(x, y), repeat)}
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOperators(A)
+    ksp.setType("cg")
+    ksp.getPC().setType("jacobi")
+    ksp.setTolerances(rtol=1e-300, atol=1e-300, max_it=50)
+    ksp.setConvergenceTest(lambda *a: 0)  # exactly max_it iterations
+    ksp.setErrorIfNotConverged(False)
+    ksp.setUp()
+    out["cg_iteration_us"] = 1e6 * _best(lambda: ksp.solve(y, x), 1) / 50
+    chol = PETSc.KSP().create(comm)
+    chol.setOperators(A)
+    chol.setType("preonly")
+    chol.getPC().setType("cholesky")
+    chol.setUp()
+    out["cholesky_solve_us"] = 1e6 * _best(lambda: chol.solve(y, x), max(3, repeat // 10))
+    return out
+
+
+def profile(example) -> dict:
+    ex = examples.get(example)
+    size = {"h": 0.15} if example == "3.3-ex3" else {"n": args.n}
+    k = ex.k
+    T = k * (args.warmup + args.steps)
+    overrides = {"stability_check": "off"} if "stability_check" in ex.params.extra else None
+    s = ex.build(comm, k=k, T=T, overrides=overrides, **size)
+    s.initialize()
+    for _ in range(args.warmup):
+        s.advance()
+    timings0 = dict(getattr(s, "timings", {}))
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    for _ in range(args.steps):
+        s.advance()
+        s.scalars()  # what the runner asks after every step (history.csv)
+    wall = (time.perf_counter() - wall0) / args.steps
+    cpu = (time.process_time() - cpu0) / args.steps
+    split = {key: 1e3 * (value - timings0.get(key, 0.0)) / args.steps
+             for key, value in getattr(s, "timings", {}).items()
+             if isinstance(value, float) and key != "stability"}
+    floor = floors(s.u.function_space)
+    step_us = 1e6 * wall
+    return {"example": example, **size, "k": k, "dofs_u": floor["dofs"],
+            "wall_ms_per_step": 1e3 * wall, "cpu_ms_per_step": 1e3 * cpu,
+            "split_ms_per_step": {key: round(v, 4) for key, v in split.items()},
+            "floor_us": {key: round(v, 2) for key, v in floor.items() if key != "dofs"},
+            "step_over_spmv": step_us / floor["spmv_us"],
+            "step_over_cg_iteration": step_us / floor["cg_iteration_us"],
+            "step_over_cholesky_solve": step_us / floor["cholesky_solve_us"]}
+
+
+rows = []
+for example in PROBLEMS:
+    if args.only and example not in args.only:
+        continue
+    row = profile(example)
+    rows.append(row)
+    print(json.dumps(row), flush=True)
+out = Path(args.out)
+out.mkdir(parents=True, exist_ok=True)
+stem = f"step_floor_n{args.n}" + (f"_{args.label}" if args.label else "")
+import damage_dolfinx  # noqa: E402 (which checkout ran)
+(out / f"{stem}.json").write_text(json.dumps(
+    {"load_average": [round(x, 2) for x in os.getloadavg()],
+     "code": str(Path(damage_dolfinx.__file__).parent), "rows": rows}, indent=1))
+lines = ["| example | dofs (u) | ms per step (wall / CPU) | split (ms) | SpMV / CG it / Cholesky "
+         "solve (us) | step over SpMV / CG it / Cholesky solve |", "|---|---|---|---|---|---|"]
+for r in rows:
+    f = r["floor_us"]
+    split = ", ".join(f"{k} {v:.2f}" for k, v in r["split_ms_per_step"].items())
+    lines.append(f"| {r['example']} | {r['dofs_u']} | {r['wall_ms_per_step']:.2f} / "
+                 f"{r['cpu_ms_per_step']:.2f} | {split} | {f['spmv_us']:.0f} / "
+                 f"{f['cg_iteration_us']:.0f} / {f['cholesky_solve_us']:.0f} | "
+                 f"{r['step_over_spmv']:.0f} / {r['step_over_cg_iteration']:.0f} / "
+                 f"{r['step_over_cholesky_solve']:.1f} |")
+(out / f"{stem}.md").write_text("\n".join(lines) + "\n")
+print("\n".join(lines))
