@@ -14,6 +14,7 @@ benchmarks/reference_output/step_floor/step_floor_n<N>.json and .md (--out to ch
 """
 import argparse
 import json
+import sys
 import os
 import time
 from pathlib import Path
@@ -25,6 +26,9 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat, examples
 from damage_dolfinx.constitutive import eps
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from timing import best  # noqa: E402
 
 PROBLEMS = ["2.1-ex1", "2.2-ex1", "2.3-ex1", "2.4-ex1", "3.1-ex1", "3.2-ex1", "3.3-ex1",
             "3.3-ex3"]
@@ -42,16 +46,6 @@ if comm.size != 1:
     raise SystemExit("step_floor.py is a serial profile")
 
 
-def _best(fn, repeat, blocks=5) -> float:
-    best = float("inf")
-    for _ in range(blocks):
-        start = time.perf_counter()
-        for _ in range(repeat):
-            fn()
-        best = min(best, (time.perf_counter() - start) / repeat)
-    return best
-
-
 def floors(V) -> dict:
     """Microseconds: SpMV, one CG + Jacobi iteration and one Cholesky solve with M + K_eps."""
     du, w = ufl.TrialFunction(V), ufl.TestFunction(V)
@@ -62,7 +56,7 @@ def floors(V) -> dict:
     x, y = A.createVecRight(), A.createVecLeft()
     x.setRandom()
     repeat = max(10, int(2e6 / A.getSize()[0]))
-    out = {"dofs": A.getSize()[0], "spmv_us": 1e6 * _best(lambda: A.mult(x, y), repeat)}
+    out = {"dofs": A.getSize()[0], "spmv_us": 1e6 * best(lambda: A.mult(x, y), repeat)}
     ksp = PETSc.KSP().create(comm)
     ksp.setOperators(A)
     ksp.setType("cg")
@@ -71,13 +65,13 @@ def floors(V) -> dict:
     ksp.setConvergenceTest(lambda *a: 0)  # exactly max_it iterations
     ksp.setErrorIfNotConverged(False)
     ksp.setUp()
-    out["cg_iteration_us"] = 1e6 * _best(lambda: ksp.solve(y, x), 1) / 50
+    out["cg_iteration_us"] = 1e6 * best(lambda: ksp.solve(y, x), 1) / 50
     chol = PETSc.KSP().create(comm)
     chol.setOperators(A)
     chol.setType("preonly")
     chol.getPC().setType("cholesky")
     chol.setUp()
-    out["cholesky_solve_us"] = 1e6 * _best(lambda: chol.solve(y, x), max(3, repeat // 10))
+    out["cholesky_solve_us"] = 1e6 * best(lambda: chol.solve(y, x), max(3, repeat // 10))
     return out
 
 

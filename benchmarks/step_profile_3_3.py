@@ -19,6 +19,7 @@ benchmarks/reference_output/step_profile_3_3/<example>_<size>.json (--out to cha
 """
 import argparse
 import json
+import sys
 import time
 from collections import defaultdict
 from pathlib import Path
@@ -29,6 +30,9 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat, examples
 from damage_dolfinx.problems import fully_damageable_3_3 as fd
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from timing import best  # noqa: E402
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--example", default="3.3-ex3")
@@ -115,24 +119,13 @@ class Profiled:
         return out
 
 
-def _best(fn, repeat, blocks=5) -> float:
-    """Seconds per call of fn, the fastest of ``blocks`` blocks (robust on a loaded machine)."""
-    best = float("inf")
-    for _ in range(blocks):
-        start = time.perf_counter()
-        for _ in range(repeat):
-            fn()
-        best = min(best, (time.perf_counter() - start) / repeat)
-    return best
-
-
 def floors(stepper, repeat=200) -> dict:
     """Microseconds (fastest of 5 blocks): SpMV and one CG + Jacobi iteration with the velocity
     matrix; SpMV with the damage matrix."""
     A = stepper.mech.A
     x, y = A.createVecRight(), A.createVecLeft()
     x.setRandom()
-    spmv = _best(lambda: A.mult(x, y), repeat)
+    spmv = best(lambda: A.mult(x, y), repeat)
     ksp = PETSc.KSP().create(comm)
     ksp.setOperators(A)
     ksp.setType("cg")
@@ -141,7 +134,7 @@ def floors(stepper, repeat=200) -> dict:
     ksp.setConvergenceTest(lambda *a: 0)  # never converged: exactly max_it iterations
     ksp.setErrorIfNotConverged(False)
     ksp.setUp()
-    cg = _best(lambda: ksp.solve(y, x), 1) / max(ksp.getIterationNumber(), 1)
+    cg = best(lambda: ksp.solve(y, x), 1) / max(ksp.getIterationNumber(), 1)
     out = {"velocity_dofs": A.getSize()[0], "velocity_nnz": int(A.getInfo()["nz_used"]),
            "spmv_us": 1e6 * spmv, "cg_iteration_us": 1e6 * cg}
     fast = getattr(stepper.mech, "fast", None)
@@ -162,7 +155,7 @@ def floors(stepper, repeat=200) -> dict:
         B = stepper.damage.A
         x, y = B.createVecRight(), B.createVecLeft()
         out.update(damage_dofs=B.getSize()[0],
-                   damage_spmv_us=1e6 * _best(lambda: B.mult(x, y), repeat))
+                   damage_spmv_us=1e6 * best(lambda: B.mult(x, y), repeat))
     return out
 
 
