@@ -118,10 +118,11 @@ def test_von_mises_3x3(cube):
 
 
 def test_2d_runs_unchanged(tmp_path):
-    """The fixed small 2-D runs of benchmarks/threed_2d_reference.py (2.1-ex1 n = 10, k = 0.05,
-    T = 1; 2.2-ex1 n = 8, T = 0.2) equal the runs recorded before any issue-17 change (commit
-    549c1d6, tests/data/reference_2d.json) to round-off: history scalars at every step and
-    final nodal fields."""
+    """The fixed small 2-D runs of benchmarks/threed_2d_reference.py, one or more per problem
+    (2.1-ex1, 2.2-ex1, 2.2-ex3, 2.3-ex1, 2.4-ex1, 3.1-ex2, 3.2-ex1, 3.3-ex2), equal the runs
+    recorded at 0c50637 (tests/data/reference_2d.json; 2.1-ex1 and 2.2-ex1 there equal the
+    first recording, 549c1d6, before any issue-17 change) to round-off: every history column at
+    every step and every final nodal field."""
     sys.path.insert(0, str(HERE.parent / "benchmarks"))
     from threed_2d_reference import CASES, REFERENCE, compare, run_case
     ref = json.loads(REFERENCE.read_text())
