@@ -5,8 +5,8 @@ Sources, each traceable to the command that produced it:
 * convergence tables: ``<results>/convergence/<study>/`` if present, else the committed outputs
   in ``benchmarks/reference_output/convergence/<study>/``;
 * bridge failure load: the figure run of 2.1-ex3 or ``reference_output/bridge``;
-* friction CPU comparison: ``reference_output/friction_cpu/cpu.md`` and ``friction_cpu_stick/cpu.md``
-  (benchmarks/friction_cpu_2_2.py);
+* benchmark records (wall times, performance, friction CPU, per-step floor, 3-D scaling):
+  report_records.py;
 * assumptions: the catalogue (every example's list, with the PROBLEMS.md gap numbers).
 The document: title block with the verdict counts, TOC, summary table (one row per thesis table
 and figure, thesis order: report_figures.py and benchmarks/fidelity.py), known differences,
@@ -22,9 +22,8 @@ import time
 from pathlib import Path
 
 from .report_doc import Doc, _inline
-
-REPO = Path(__file__).resolve().parents[1]
-REFERENCE = REPO / "benchmarks" / "reference_output"
+from .report_records import (REFERENCE, REPO, _bridge, _friction_cpu, _performance, _shown,
+                             _status, _step_floor, _threed_scaling, _wall_times)
 SECTION_TITLES = {
     "2.1": "Section 2.1: quasistatic elastic body with damage",
     "2.2": "Section 2.2: quasistatic Kelvin-Voigt contact with Tresca friction",
@@ -251,7 +250,8 @@ def build(results: Path) -> Path:
     if readings.is_file():
         toc.append(("readings", "Readings of the thesis data (benchmarks/readings.md)"))
     toc += [(f"sec-{s.replace('.', '-')}", t) for s, t in SECTION_TITLES.items()]
-    toc += [("wall-times", "Wall times"), ("performance", "Performance")]
+    toc += [("wall-times", "Wall times"), ("performance", "Performance"),
+            ("step-floor", "Per-step cost against its floor"), ("scaling-3d", "3-D scaling")]
     doc.raw('<nav class="toc"><h2 class="first" id="contents">Contents</h2><ol>'
             + "".join(f'<li><a href="#{a}">{html.escape(t)}</a></li>' for a, t in toc)
             + "</ol></nav>", "\n".join(f"- [{t}](#{a})" for a, t in toc))
@@ -304,6 +304,8 @@ def build(results: Path) -> Path:
             doc.items(ex.assumptions)
     _wall_times(doc, figs.sources[0][1] if figs.sources else None, conv_index)
     _performance(doc, results)
+    _step_floor(doc)
+    _threed_scaling(doc)
     md, page = results / "REPORT.md", results / "REPORT.html"
     md.write_text(doc.to_markdown())
     page.write_text(doc.to_html("damage-dolfinx: reproduction of Campo (2007)"))
@@ -394,42 +396,6 @@ def _fidelity_table(doc, t):
              + f" Source: {t['source']} (`{_shown(Path(t['folder']))}`). Verdict: **{t['verdict']}**.")
 
 
-def _status(entry) -> str:
-    """A run's status in index.json ("completed", ...) or its exit code."""
-    return entry.get("status") or f"exit {entry['returncode']}"
-
-
-def _wall_times(doc, fig_index, conv_index):
-    """Wall time of every run of this reproduction (figure runs and convergence studies)."""
-    groups = (("figures", (fig_index or {}).get("runs", [])),
-              ("convergence", conv_index.get("studies", [])))
-    rows = [(f"{kind}: {e['example']} {e['variant']}".rstrip(), _status(e), e["wall_time_s"])
-            for kind, entries in groups for e in entries]
-    doc.anchor_heading(2, "Wall times of this reproduction", "wall-times")
-    if not rows:
-        doc.para("No run in this results folder.")
-        return
-    total = sum(t for _, _, t in rows)
-    doc.markdown_table("| run | status | wall time [s] |\n|---|---|---|\n"
-                       + "".join(f"| {name} | {status} | {t:.1f} |\n" for name, status, t in rows)
-                       + f"| **total** | | **{total:.0f}** ({total / 3600:.2f} h) |\n")
-
-
-def _performance(doc, results):
-    """Time per step vs dofs, serial and 2 ranks (benchmarks/performance.py)."""
-    doc.anchor_heading(2, "Performance: time per step vs dofs, serial and 2 MPI ranks",
-                       "performance")
-    for table in (results / "performance" / "performance.md", REFERENCE / "performance" / "performance.md"):
-        if table.is_file():
-            doc.para(f"`python benchmarks/performance.py`, from `{_shown(table)}`.")
-            doc.markdown_table(table.read_text())
-            doc.note("Columns: dofs (u) = displacement unknowns; serial / 2 ranks = wall time per "
-                     "time step; speed-up = serial over 2-rank time per step; `(ref)` marks the "
-                     "convergence reference size.")
-            return
-    doc.para("No performance record.")
-
-
 def _convergence_of(doc, results, example_id, variant, commands, full=True):
     name = example_id + (f"-{variant}" if variant else "")
     folder = _study_folder(results, name)
@@ -453,43 +419,3 @@ def _convergence_of(doc, results, example_id, variant, commands, full=True):
     if len(tables) == 2 and tables[0] == tables[1]:
         doc.note("The final-time table equals the max-over-time table: for this study the "
                  "maximum over time of the error is attained at the final time T.")
-
-
-def _shown(folder: Path) -> str:
-    return str(folder.relative_to(REPO)) if REPO in folder.parents else str(folder)
-
-
-def _bridge(doc, s, path):
-    """Failure load and hinges: from this report's figure run if it has one, else committed."""
-    hinges = ", ".join(f"{h.get('angle_deg', h.get('theta_deg', '?'))}" for h in s.get("hinges", []))
-    doc.para(f"**Bridge failure load {s['failure_load_kN']:.1f} kN** (thesis: damage model "
-             f"{s['thesis']['damage_model_kN']} kN, contact model {s['thesis']['contact_model_kN']} kN)"
-             f" at step {s['failure_step']}, load increment {s['load_increment_kN']} kN, "
-             f"h = {s['h']}, k = {s['k']}, {s['n_hinges']} hinges (angles: {hinges}); "
-             f"calibration: {s.get('calibrated')}; source `{_shown(path)}` "
-             f"(`benchmarks/bridge_collapse.py`).")
-
-
-def _friction_cpu(doc):
-    explain = ("Columns: n, k = mesh and time step; Newton / Uzawa / penalty-duality s = wall "
-               "time of the whole run (T = 1) per friction solver; floor s = one factorised "
-               "linear solve per step plus the damage steps (the least any solver can cost); "
-               "Newton/floor, Uzawa/Newton, PD/Newton = ratios of those times; friction step s = "
-               "time in the friction solve only (Newton / Uzawa / PD) and the two ratios after "
-               "it; Uzawa-Newton (V), PD-Newton (V) = relative V-norm distance of the final "
-               "displacements to Newton's. '-' = skipped after the time budget.")
-    table = REFERENCE / "friction_cpu" / "cpu.md"
-    if table.is_file():
-        doc.para("CPU comparison of the three friction solvers (thesis Tables 2.2/2.3; "
-                 "`python benchmarks/friction_cpu_2_2.py`, committed output "
-                 "`benchmarks/reference_output/friction_cpu/cpu.md`):")
-        doc.markdown_table(table.read_text())
-        doc.note(explain)
-    stick = REFERENCE / "friction_cpu_stick" / "cpu.md"
-    if stick.is_file():
-        doc.para("The same with stick-slip (friction bound g = 200 instead of 5, Uzawa step "
-                 "rho = 1e-3 from the G8 sweep at n = 16; `python benchmarks/friction_cpu_2_2.py "
-                 "--set g_fric=200 rho_uzawa=1e-3`, output "
-                 "`benchmarks/reference_output/friction_cpu_stick/cpu.md`):")
-        doc.markdown_table(stick.read_text())
-        doc.note(explain)

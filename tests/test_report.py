@@ -42,6 +42,9 @@ def test_quick_figures_and_report(tmp_path):
     assert toc and set(toc) <= anchors
     assert re.search(r"\d+ reproduced, \d+ differ, \d+ not comparable", text)
     assert 'id="fig-2-14"' in text and "thesis lines" in text   # the produced figure, captioned
+    for anchor in ("performance", "step-floor", "scaling-3d"):  # the benchmark records
+        assert f'id="{anchor}"' in text and f'href="#{anchor}"' in text
+    assert "step over SpMV" in md and "dofs u" in md     # floor profile and 3-D scaling tables
     _damage_bars_fixed_and_factors_round(tmp_path / "figures", index)
     if CHROMIUM is None:
         pytest.skip("chromium not installed (make setup installs it)")
