@@ -165,7 +165,7 @@ def examples():
             "damage field; benchmarks/wrench_3_3.py also draws the bare wire mesh), von "
             "Mises (3.21) and damage (3.22) at T"],
         figures=[Figure("figure_3_19.png", "Example 3.3-3: setting and mesh", kind="mesh"),
-                 Figure("figure_3_20.png", "Example 3.3-3: deformed configuration (x2)",
+                 Figure("figure_3_20.png", "Example 3.3-3: deformed configuration",
                         fields=("zeta",), amplification=2.0, mesh_lines=True),
                  Figure("figure_3_21.png", "Example 3.3-3: von Mises stress",
                         fields=("von_mises",), amplification=2.0),
