@@ -47,7 +47,8 @@ class MemoryTerm:
             raise InputError(f"memory mode {mode!r} does not apply to a {kernel.kind} kernel "
                              "(use 'sum' or the matching mode)")
         self.kernel, self.k, self.mode = kernel, float(k), mode
-        self.space = compat.function_space(msh, "DG", 1, (2, 2))
+        d = msh.topology.dim  # 2x2 (the thesis) or 3x3 tensors (issue 17)
+        self.space = compat.function_space(msh, "DG", 1, (d, d))
         self.M = fem.Function(self.space, name="memory")
         self.g = fem.Function(self.space, name="memory_integrand")
         self.history = []  # g_0, g_1, ... ('sum' mode only)
