@@ -40,7 +40,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
-from .constitutive import B_plane_stress, eps
+from .constitutive import B, eps
 from .parameters import InputError
 
 #: safety factor of the suggested time step (PROBLEMS.md 1.8: return 0.8 k_max)
@@ -274,7 +274,7 @@ def stiffness_and_mass(V, E, nu, rho, c_nu=0.0, dsC=None, bcs=(), normal=None):
     with the cell and the facet integral, so that both share the sparsity and the Dirichlet
     rows), K is K_B itself without contact (c_nu = 0 or dsC None)."""
     u, w = ufl.TrialFunction(V), ufl.TestFunction(V)
-    k_B = ufl.inner(B_plane_stress(eps(u), E, nu), eps(w)) * ufl.dx
+    k_B = ufl.inner(B(eps(u), E, nu), eps(w)) * ufl.dx  # plane stress in 2-D, 3-D Hooke
     K_B = _assembled(k_B, bcs)
     M = _assembled(fem.Constant(V.mesh, float(rho)) * ufl.inner(u, w) * ufl.dx, bcs)
     K = K_B
