@@ -15,7 +15,7 @@ only; the step is then nonlinear (semismooth in the contact term) and returned a
 """
 import ufl
 
-from damage_dolfinx.constitutive import B_plane_stress, Phi_L, eps, eta_star
+from damage_dolfinx.constitutive import B, Phi_L, eps, eta_star
 from damage_dolfinx.contact import positive_part
 
 from .elastic_damage import load
@@ -32,12 +32,12 @@ def _measures(dsC):
 
 def damaged_viscous_stress(v, zeta, E, nu, m_visc, zeta_star):
     """eta_*(zeta) A eps(v), A = B / m_visc (3.111, 3.122)."""
-    return eta_star(zeta, zeta_star) * B_plane_stress(eps(v), E, nu) / m_visc
+    return eta_star(zeta, zeta_star) * B(eps(v), E, nu) / m_visc
 
 
 def damaged_elastic_stress(u, zeta, E, nu, L_trunc, zeta_star):
     """E(eps(u), eta_*(zeta)) = eta_*(zeta) Phi_L(B eps(u)) (3.111, 2.106)."""
-    return eta_star(zeta, zeta_star) * Phi_L(B_plane_stress(eps(u), E, nu), L_trunc)
+    return eta_star(zeta, zeta_star) * Phi_L(B(eps(u), E, nu), L_trunc)
 
 
 def total_stress(v, u, zeta, E, nu, m_visc, L_trunc, zeta_star):
@@ -74,7 +74,7 @@ def velocity_matrix_parts(v, w, rho, k, E, nu, m_visc):
     (there eta_*(zeta_n) = zeta_n): a_visc is LINEAR in z, so the matrix of (3.159) is
     M_rho/k + sum_j zeta_n,j W_j, updated from the nodal zeta_n without re-assembly (3.3 module)."""
     a_mass = rho / k * ufl.inner(v, w) * ufl.dx                    # (3.159) (rho v_n / k, w)_H
-    a_visc = lambda z: ufl.inner(z * B_plane_stress(eps(v), E, nu) / m_visc,  # noqa: E731
+    a_visc = lambda z: ufl.inner(z * B(eps(v), E, nu) / m_visc,  # noqa: E731
                                  eps(w)) * ufl.dx                  # (3.159) (zeta A eps(v_n), eps(w))_Q
     return a_mass, a_visc
 

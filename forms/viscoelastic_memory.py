@@ -7,7 +7,7 @@ g(eps, zeta) = zeta Phi_L(B eps) (memory.py).
 """
 import ufl
 
-from damage_dolfinx.constitutive import B_plane_stress, Phi_L, eps
+from damage_dolfinx.constitutive import B, Phi_L, eps
 from damage_dolfinx.contact import normal_compliance_term
 
 from .elastic_damage import load
@@ -15,12 +15,12 @@ from .elastic_damage import load
 
 def memory_integrand(u, zeta, E, nu, L_trunc):
     """g(eps(u), zeta) = zeta Phi_L(B eps(u)) (kernel G = a(t - s) g, Section 1.6)."""
-    return zeta * Phi_L(B_plane_stress(eps(u), E, nu), L_trunc)
+    return zeta * Phi_L(B(eps(u), E, nu), L_trunc)
 
 
 def total_stress(u, M, E, nu):
     """sigma_n = B eps(u_n) + M_n."""
-    return B_plane_stress(eps(u), E, nu) + M
+    return B(eps(u), E, nu) + M
 
 
 def displacement_residual(u, w, M, E, nu, c_nu, gap, n, f_B, f_N, dsN, dsC):

@@ -4,12 +4,52 @@ The thesis is 2-D plane stress (PROBLEMS.md Section 0); these entries keep each 
 and change only the body to a 3-D one, the elasticity to isotropic 3-D Hooke (whose plane-stress
 reduction is B (2.36)) and the strain of the damage source to the full 3x3 strain.
 """
+import dataclasses
 import math
 
 import ufl
 
 from ..examples import Example, Figure
+from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from ..parameters import ModelParameters
+
+#: 3-D contact examples (issue 17, "3-D: contact" in benchmarks/README.md): default mesh sizes and
+#: time steps; the k of the explicit dynamic schemes is at most 0.8 k_max of stability.py at the
+#: default mesh (measured, listed in each entry's assumptions)
+N_2_3_EX1, N_3_1_EX1, N_3_3_EX1 = 8, 12, 12
+K_3_1_EX1 = 0.005
+
+
+def _thesis_entry(section_module, example_id):
+    """The 2-D catalogue entry whose data a 3-D example keeps."""
+    import importlib
+    module = importlib.import_module(f"{__package__}.{section_module}")
+    return next(ex for ex in module.examples() if ex.id == example_id)
+
+
+def _from_2d(ex2d, **changes):
+    """A 3-D entry with the data of ``ex2d``: its parameters, time grid and reading; geometry,
+    loads, figures and assumptions replaced; no convergence study (a 3-D reference at n = 256
+    is out of reach)."""
+    changes.setdefault("assumptions", [])
+    changes["assumptions"] = (
+        [f"issue 17 (beyond the thesis): the 3-D counterpart of {ex2d.id} with its data; its "
+         "2-D assumptions follow (marked '2-D:'), the geometry, mesh and time-step lines among "
+         "them superseded by the 3-D lines after them"]
+        + [f"2-D: {a}" for a in ex2d.assumptions] + changes["assumptions"])
+    return dataclasses.replace(ex2d, dim=3, convergence=None, literal=None, reading=None,
+                               **changes)
+
+
+_3D_COMMON = [
+    "3-D isotropic elasticity lambda tr(eps) I + 2 mu eps (its plane-stress reduction is B of "
+    "(2.36)); Phi_L componentwise on the 3x3 tensor; the split of phi uses the eigenvalues of "
+    "the 3x3 strain",
+    "normal compliance p_nu(u.nu - gap) = c_nu (u.nu - gap)_+ on a plane face of the box "
+    "(nu its outward normal), frictionless: the same weak term as in 2-D",
+    "1.9/G37 in 3-D: von Mises sqrt(3/2 dev(sigma):dev(sigma)), cell-wise (DG0)",
+    "figures: sections through the body (slices.py); XDMF of u, zeta, von Mises for ParaView",
+]
 
 
 def examples():
@@ -42,4 +82,40 @@ def examples():
         ],
         figures=[Figure("fields_slices.png", "Example 2.1-1 in 3-D: von Mises stress and damage",
                         kind="slices")])
-    return [ex1]
+    return [ex1] + contact_examples()
+
+
+def _box_geometry(L, n, boundary):
+    from ..geometries.box import box
+    return lambda comm, n_, h: box(comm, (0.0, 0.0, 0.0), (L, L, L), (n_, n_, n_), boundary)
+
+
+def contact_examples():
+    """2.3, 3.1 and 3.3 on boxes, and the wrench plate (3.3-ex3-3d)."""
+    from ..geometries.box import face
+
+    slices = [Figure("fields_slices.png", "", kind="slices")]
+
+    def figs(title):
+        return [dataclasses.replace(f, title=title) for f in slices]
+
+    ex23 = _from_2d(
+        _thesis_entry("section_2_3", "2.3-ex1"), id="2.3-ex1-3d",
+        title="3-D: unit cube clamped at x = 0 on a normal-compliance foundation z = 0, "
+              "traction (-10,0,-10) on x = 1",
+        n=N_2_3_EX1, diameter=math.sqrt(3),
+        make_geometry=_box_geometry(1.0, N_2_3_EX1, {
+            GAMMA_D: face(0, 0.0), GAMMA_C: face(2, 0.0), GAMMA_N: face(0, 1.0)}),
+        traction=lambda x, t: ufl.as_vector((-10.0, 0.0, -10.0)),
+        assumptions=_3D_COMMON + [
+            "geometry: the unit square (x, y) of 2.3-ex1 becomes the cube with its y axis as z: "
+            "Gamma_D = {x = 0}, Gamma_C = {z = 0} (foundation below), Gamma_N = {x = 1} with "
+            "f_N = (-10, 0, -10); y = 0, y = 1, z = 1 traction-free",
+            "memory M_n a DG1 3x3 tensor field (running sum, constant kernel)",
+            f"structured n x n x n grid, 6 tetrahedra per hexahedron; run defaults n = "
+            f"{N_2_3_EX1}, k = 0.01, T = 1 (the 2-D run's k and T)",
+            "solvers: Newton (semismooth in the contact term) with CG on a lagged factorisation "
+            "below 3000 unknowns, CG + GAMG (rigid-body modes) above; damage PDE direct / "
+            "CG + BoomerAMG likewise (scalable.py)"],
+        figures=figs("Example 2.3-1 in 3-D: von Mises stress and damage"))
+    return [ex23]

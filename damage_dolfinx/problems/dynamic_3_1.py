@@ -10,7 +10,10 @@ inclusion (variant A), scheme (3.48)-(3.51):
 
 V = {v = 0 on Gamma_D}; u_0 = v_0 = 0, zeta_0 from the example. The matrix of (2) does not change
 for a fixed k: it is factorised once (MUMPS, prefix ``mech_``), each step assembles a right-hand
-side. Damage prefix ``damage_``. Parameters in ``extra``: rho, m_visc, c_nu, gap,
+side. The dimension comes from the mesh (issue 17): on 3-D meshes with at least
+``VELOCITY_DIRECT_MAX_DOFS_3D`` unknowns the velocity system is solved by CG + GAMG with the
+rigid-body near-nullspace (AMG set up once, CG started from v_{n-1}) instead.
+Damage prefix ``damage_``. Parameters in ``extra``: rho, m_visc, c_nu, gap,
 ``damage_active`` (False: zeta frozen at zeta_0 and step (1) skipped, Example 3's undamaged run)
 ``stability_check`` (warn | error | off: k against the limit of the explicit elastic and
 contact forces, stability.py, PROBLEMS.md 1.8) and ``error_norm`` (velocity: convergence errors
@@ -28,12 +31,17 @@ from mpi4py import MPI
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
-from .. import compat
+from .. import compat, scalable
 from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from ..forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from ..solvers import LinearSolver
 from .base import ProblemData, TimeStepper
+
+
+#: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation
+#: (measured crossover, benchmarks/README.md "3-D: contact")
+VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
 
 
 class DynamicKelvinVoigt(TimeStepper):
@@ -77,7 +85,10 @@ class DynamicKelvinVoigt(TimeStepper):
                                    const(self.gap), self.n_facet, f_B, f_N, ds(GAMMA_N),
                                    ds(GAMMA_C) if self.has_contact else None)
         self.bcs = [clamped(V, tags, GAMMA_D)]
-        self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context, constant_matrix=True)
+        amg = msh.topology.dim == 3 and scalable.global_dofs(V) >= VELOCITY_DIRECT_MAX_DOFS_3D
+        self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context, constant_matrix=True,
+                                 defaults=scalable.MECH_AMG if amg else None)
+        scalable.prepare_mech(self.mech, V)  # 3-D: near-nullspace, warm start; 2-D: nothing
         self.stability = self._stability_check(V, x, ds(GAMMA_C))
 
         # output: von Mises of the total stress and of the strain (PROBLEMS.md 1.9), DG0
@@ -145,7 +156,7 @@ class DynamicKelvinVoigt(TimeStepper):
     def u_max(self) -> float:
         """max over the nodes of |u_n| (the L-shape comparison of Example 3)."""
         owned = self.u.function_space.dofmap.index_map.size_local
-        u = self.u.x.array.reshape(-1, 2)[:owned]
+        u = self.u.x.array.reshape(-1, self.mesh.topology.dim)[:owned]
         return self.comm.allreduce(float(np.linalg.norm(u, axis=1).max()) if owned else 0.0,
                                    op=MPI.MAX)
 

@@ -7,7 +7,11 @@ and damage (PDE form, variant A), scheme (2.136)-(2.137).
           (B eps(u_n) + M_n, eps(w)) + (p_nu(u_n.nu - gap), w.nu)_{Gamma_C} = L_n(w)         (2.137)
 
 p_nu(r) = c_nu r_+ (semismooth Newton, SNES prefix ``mech_``); damage PDE step prefix
-``damage_`` (matrix factorised once). The memory term is updated in O(1) per step for constant
+``damage_`` (matrix factorised once). The dimension comes from the mesh (issue 17): on a 3-D mesh
+B is 3-D Hooke, M_n a 3x3 tensor, Gamma_C any plane or curved face; from
+``scalable.DIRECT_MAX_DOFS_3D`` unknowns on, Newton's linear systems are solved by CG + GAMG
+with the rigid-body near-nullspace (the AMG hierarchy lagged like the factorisation in 2-D) and
+the damage PDE by CG + BoomerAMG. The memory term is updated in O(1) per step for constant
 and exponential kernels (memory.py).
 """
 from __future__ import annotations
@@ -19,14 +23,14 @@ from dolfinx import fem
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
-from .. import compat
+from .. import compat, scalable
 from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from ..damage import DamageStep, source
 from ..forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
 from ..memory import MemoryKernel, MemoryTerm
 from ..parameters import InputError
-from ..solvers import NonlinearSolver
+from ..solvers import NEWTON, NonlinearSolver
 from .base import ProblemData, TimeStepper
 
 
@@ -53,7 +57,8 @@ class ViscoelasticMemoryContact(TimeStepper):
         phi_old = source(eps(self.u), self.zeta_old, p)
         self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, k),
                                  fem.Constant(msh, float(p.kappa)), self.context,
-                                 obstacle=False, zeta_star=p.zeta_star, prefix=damage_prefix)
+                                 obstacle=False, zeta_star=p.zeta_star, prefix=damage_prefix,
+                                 linear_defaults=scalable.damage_config(Z))
 
         # (2.136): memory, g evaluated at (u_{n-1}, zeta_{n-1}) before u and zeta move on
         kernel = MemoryKernel(x["memory_kernel"], float(x.get("memory_amplitude", 1.0)),
@@ -71,8 +76,17 @@ class ViscoelasticMemoryContact(TimeStepper):
                                   self.c_nu, self.gap, self.n_facet, f_B, f_N, ds(GAMMA_N),
                                   ds(GAMMA_C))
         bc = clamped(V, tags, GAMMA_D)
-        self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
-                                    refactor_after_its=MECH_REFACTOR_ITS)
+        if scalable.iterative(V):  # 3-D at size: CG + GAMG, hierarchy rebuilt as P is
+            self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
+                                        defaults={**NEWTON, **scalable.MECH_AMG},
+                                        refactor_after_its=scalable.MECH_AMG_REBUILD_ITS)
+            J, P = self.mech.snes.snes.getJacobian()[:2]
+            modes = scalable.rigid_body_modes(V)
+            for A in (J, P):
+                A.setNearNullSpace(modes)
+        else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation
+            self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
+                                        refactor_after_its=MECH_REFACTOR_ITS)
 
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
