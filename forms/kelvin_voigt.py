@@ -6,19 +6,19 @@ A = B / m_visc (viscosity, implicit), damaged truncated elasticity explicit (2.1
 """
 import ufl
 
-from damage_dolfinx.constitutive import B_plane_stress, Phi_L, eps
+from damage_dolfinx.constitutive import B, Phi_L, eps
 
 from .elastic_damage import load
 
 
 def viscous_stress(v, E, nu, m_visc):
     """A eps(v) with A = B / m_visc."""
-    return B_plane_stress(eps(v), E, nu) / m_visc
+    return B(eps(v), E, nu) / m_visc
 
 
 def damaged_elastic_stress(u, zeta, E, nu, L_trunc):
     """zeta Phi_L(B eps(u)) (2.106)."""
-    return zeta * Phi_L(B_plane_stress(eps(u), E, nu), L_trunc)
+    return zeta * Phi_L(B(eps(u), E, nu), L_trunc)
 
 
 def velocity_step_forms(v, w, u_old, zeta_old, E, nu, m_visc, L_trunc, f_B, f_N, dsN):
