@@ -181,11 +181,31 @@ class FullyDamageableContact(TimeStepper):
 
     def checkpoint_state(self) -> dict:
         """u, zeta, v and, for the CG start's extrapolation, v_{n-2}, v_{n-3}, v_{n-4}: without
-        them a resumed run starts its CG elsewhere and differs at the solver tolerance (2e-11)."""
+        them a resumed run starts its CG elsewhere and differs at the solver tolerance (2e-11).
+        ``monitors``: what summary.json reports over all steps (the maximal interpenetration,
+        its time and place; the first time the probe reaches zeta_star, NaN: not yet), so that
+        a resumed run reports the maximum over the whole run (collective)."""
         state = super().checkpoint_state()
         if self.extrapolate and self.elastic_term == "explicit":
             state.update(v_old=self.v_old, v_older3=self._v_older[0], v_older4=self._v_older[1])
+        first = self.probe.first_zeta_star_time
+        self._monitors = np.array(self.contact.state() + [math.nan if first is None else first])
+        state["monitors"] = self._monitors
         return state
+
+    def restore(self, n: int):
+        super().restore(n)
+        *contact, first = self._monitors
+        self.contact.set_state(contact)
+        self.probe.first_zeta_star_time = None if math.isnan(first) else float(first)
+
+    def track(self):
+        """Between history rows (runner, history_every > 1): only what summary.json reports
+        over all steps, the maximal interpenetration and the first time the probe reaches
+        zeta_star (in serial no communication)."""
+        self.contact.track(self.u, self.t)
+        if self.probe.point is not None:
+            self.probe(self.zeta, self.t, self.params.zeta_star)
 
     def _interpolate_zeta0(self):
         """Example 2 selects its initial damage with ``--set initial_damage=a|b``."""
@@ -278,14 +298,14 @@ class FullyDamageableContact(TimeStepper):
 class ContactMonitor:
     """Maximal interpenetration (u.nu - gap)_+ over the vertices of Gamma_C (u is P1, so the
     maximum over a facet is at a vertex), with nu the outward normal of each facet, and its
-    location; the running maximum over the run goes to summary.json."""
-
-    columns = ["penetration_max", "penetration_x1", "penetration_x2"]
+    location; the running maximum over the run goes to summary.json. Any dimension: a 3-D
+    facet is a triangle, its normal the cross product of two edges (columns get x3)."""
 
     def __init__(self, V, tags, tag, gap):
         self.comm, self.gap = V.mesh.comm, gap
         msh = V.mesh
-        tdim = msh.topology.dim
+        tdim = d = msh.topology.dim
+        self.columns = ["penetration_max"] + [f"penetration_x{i + 1}" for i in range(d)]
         for dim in ((tdim, 0), (tdim - 1, 0), (tdim - 1, tdim)):
             msh.topology.create_connectivity(*dim)
         facets = tags.indices[tags.values == tag]
@@ -300,37 +320,88 @@ class ContactMonitor:
         cells = f2c.array[f2c.offsets[facets]]  # exterior facets: their only cell
         keep = cells < nc  # a facet of a ghost cell is monitored by the rank owning that cell
         facets, cells = facets[keep], cells[keep]
-        self.dofs = v2d[f2v.array.reshape(-1, 2)[facets]]            # (nf, 2) vertex dofs
-        X = V.tabulate_dof_coordinates()[:, :2]
-        self.X = X[self.dofs]                                          # (nf, 2, 2)
+        self.dofs = v2d[f2v.array.reshape(-1, d)[facets]]            # (nf, d) vertex dofs
+        X = V.tabulate_dof_coordinates()[:, :d]
+        self.X = X[self.dofs]                                          # (nf, d, d)
         cell_mid = X[v2d[cell_vertices[cells]]].mean(axis=1)
-        t = self.X[:, 1] - self.X[:, 0]
-        n = np.stack([t[:, 1], -t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
+        if d == 2:
+            t = self.X[:, 1] - self.X[:, 0]
+            n = np.stack([t[:, 1], -t[:, 0]], axis=1) / np.linalg.norm(t, axis=1)[:, None]
+        else:  # triangle: normal of its plane (the sign is fixed below)
+            n = np.cross(self.X[:, 1] - self.X[:, 0], self.X[:, 2] - self.X[:, 0])
+            n = n / np.linalg.norm(n, axis=1)[:, None]
         outward = np.einsum("ij,ij->i", n, self.X.mean(axis=1) - cell_mid) > 0
         self.normal = np.where(outward[:, None], n, -n)
         self.present = self.comm.allreduce(int(facets.size), op=MPI.SUM) > 0
+        self.d = d
+        # (u.nu - gap) at the facet vertices, facet by facet, from flat views (issue 18: the
+        # per-step track() costs a few NumPy operations on the Gamma_C dofs)
+        flat = self.dofs.reshape(-1)
+        self._index = [flat * d + c for c in range(d)]
+        self._normal = [np.repeat(self.normal[:, c], d) for c in range(d)]
+        self._at = self.X.reshape(-1, d)
         self.worst = {"max_penetration": 0.0, "max_penetration_t": 0.0,
-                      "max_penetration_at": [math.nan, math.nan]}
+                      "max_penetration_at": [math.nan] * d}
+
+    def _penetration(self, u) -> np.ndarray:
+        """u.nu - gap at every (facet, vertex) pair of this rank, facet-major."""
+        a = u.x.array
+        pen = a[self._index[0]] * self._normal[0]
+        for index, normal in zip(self._index[1:], self._normal[1:]):
+            pen += a[index] * normal
+        return pen - self.gap
+
+    def _best(self, pen) -> tuple:
+        if not pen.size:
+            return (-np.inf,) + (math.nan,) * self.d
+        i = int(np.argmax(pen))
+        return (float(pen[i]), *map(float, self._at[i]))
+
+    def _keep(self, value, t, at):
+        if value > self.worst["max_penetration"]:
+            self.worst = {"max_penetration": value, "max_penetration_t": t,
+                          "max_penetration_at": list(at)}
 
     def __call__(self, u, t) -> dict:
         if not self.present:
             return {}
-        U = u.x.array.reshape(-1, 2)[self.dofs]                       # (nf, 2, 2)
-        pen = np.einsum("fvc,fc->fv", U, self.normal) - self.gap
-        best = (-np.inf, math.nan, math.nan)
-        if pen.size:
-            i, j = np.unravel_index(np.argmax(pen), pen.shape)
-            best = (float(pen[i, j]), *map(float, self.X[i, j]))
+        best = self._best(self._penetration(u))
         candidates = self.comm.allgather(best) if self.comm.size > 1 else [best]
-        value, x1, x2 = max(candidates, key=lambda b: (b[0], -b[1], -b[2]))
+        value, *at = max(candidates, key=lambda b: (b[0],) + tuple(-c for c in b[1:]))
         value = max(value, 0.0)
-        if value > self.worst["max_penetration"]:
-            self.worst = {"max_penetration": value, "max_penetration_t": t,
-                          "max_penetration_at": [x1, x2]}
-        return {"penetration_max": value, "penetration_x1": x1, "penetration_x2": x2}
+        self._keep(value, t, at)
+        return dict(zip(self.columns, [value] + at))
+
+    def track(self, u, t):
+        """The running maximum only, without communication (each rank keeps its own; summary()
+        combines them): the per-step update between history rows."""
+        if self.present:
+            pen = self._penetration(u)
+            if pen.size and pen.max() > self.worst["max_penetration"]:
+                value, *at = self._best(pen)
+                self._keep(value, t, at)
 
     def summary(self) -> dict:
-        return dict(self.worst) if self.present else {}
+        """The maximum over all steps so far (collective in parallel): the largest value, the
+        earliest time among equal values, then the smallest coordinates."""
+        if not self.present:
+            return {}
+        if self.comm.size == 1:
+            return dict(self.worst)
+        worst = [(w["max_penetration"], w["max_penetration_t"], *w["max_penetration_at"])
+                 for w in self.comm.allgather(self.worst)]
+        value, t, *at = max(worst, key=lambda b: (b[0], -b[1]) + tuple(-c for c in b[2:]
+                                                                       if c == c))
+        return {"max_penetration": value, "max_penetration_t": t, "max_penetration_at": at}
+
+    def state(self) -> list:
+        """[max, t, x...] (summary(); collective) for the checkpoint."""
+        w = self.summary() or self.worst
+        return [w["max_penetration"], w["max_penetration_t"], *w["max_penetration_at"]]
+
+    def set_state(self, values):
+        self.worst = {"max_penetration": float(values[0]), "max_penetration_t": float(values[1]),
+                      "max_penetration_at": [float(v) for v in values[2:2 + self.d]]}
 
 
 class ZetaProbe:
