@@ -17,7 +17,9 @@ from ..parameters import ModelParameters
 #: time steps; the k of the explicit dynamic schemes is at most 0.8 k_max of stability.py at the
 #: default mesh (measured, listed in each entry's assumptions)
 N_2_3_EX1, N_3_1_EX1, N_3_3_EX1 = 8, 12, 12
-K_3_1_EX1 = 0.005
+K_3_1_EX1 = 0.01
+#: the wrench plate: gmsh size h (h/2 on the hexagon faces), time step, default final time
+H_3_3_EX3, K_3_3_EX3, T_3_3_EX3 = 0.2, 1.0e-5, 0.05
 
 
 def _thesis_entry(section_module, example_id):
@@ -118,4 +120,77 @@ def contact_examples():
             "below 3000 unknowns, CG + GAMG (rigid-body modes) above; damage PDE direct / "
             "CG + BoomerAMG likewise (scalable.py)"],
         figures=figs("Example 2.3-1 in 3-D: von Mises stress and damage"))
-    return [ex23]
+    ex31_2d = _thesis_entry("section_3_1", "3.1-ex1")
+    ex31 = _from_2d(
+        ex31_2d.literal or ex31_2d, id="3.1-ex1-3d", default_reading="literal",
+        title="3-D: cube (0,6)^3 clamped at x = 0 and x = 6, traction (20t,0,-20t) on top, "
+              "normal-compliance foundation below (dynamic)",
+        n=N_3_1_EX1, k=K_3_1_EX1, diameter=6 * math.sqrt(3),
+        make_geometry=_box_geometry(6.0, N_3_1_EX1, {
+            GAMMA_D: lambda x: face(0, 0.0)(x) | face(0, 6.0)(x), GAMMA_C: face(2, 0.0),
+            GAMMA_N: face(2, 6.0)}),
+        traction=lambda x, t: ufl.as_vector((20.0 * t, 0.0, -20.0 * t)),
+        assumptions=_3D_COMMON + [
+            "geometry: the square (0,6)^2 of 3.1-ex1 (G23 layout) becomes the cube (0,6)^3 with "
+            "its y axis as z: Gamma_D = {x = 0} and {x = 6}, Gamma_N = {z = 6} with "
+            "f_N = (20t, 0, -20t), Gamma_C = {z = 0}; y = 0 and y = 6 traction-free",
+            "data: the literal reading (c_nu = 1/mu_nc = 2e4, the stiff foundation: the point of "
+            "a contact example; --reading evidence gives the 2-D default reading R1-R2, "
+            "c_nu = 5e-5)",
+            f"structured n x n x n grid; run defaults n = {N_3_1_EX1}, T = 1, "
+            f"k = {K_3_1_EX1:g} (1.8: k_max of stability.py at n = {N_3_1_EX1} in the "
+            "assumptions below; k <= 0.8 k_max and dividing T)",
+            "solvers: velocity matrix factorised once below VELOCITY_DIRECT_MAX_DOFS_3D "
+            "unknowns, CG + GAMG (rigid-body modes, set up once) above; damage obstacle step "
+            "SNES vinewtonrsls with CG + Jacobi (as in 2-D)"],
+        figures=figs("Example 3.1-1 in 3-D: von Mises stress and damage"))
+    ex33 = _from_2d(
+        _thesis_entry("section_3_3", "3.3-ex1"), id="3.3-ex1-3d",
+        title="3-D: cube (0,6)^3 clamped at x = 0 and x = 6, traction (0,0,-10t) on top, fully "
+              "damageable contact with a foundation below (dynamic)",
+        n=N_3_3_EX1, diameter=6 * math.sqrt(3),
+        params=_thesis_entry("section_3_3", "3.3-ex1").params.replace(stability_check="warn"),
+        make_geometry=_box_geometry(6.0, N_3_3_EX1, {
+            GAMMA_D: lambda x: face(0, 0.0)(x) | face(0, 6.0)(x), GAMMA_C: face(2, 0.0),
+            GAMMA_N: face(2, 6.0)}),
+        traction=lambda x, t: ufl.as_vector((0.0, 0.0, -10.0 * t)),
+        assumptions=_3D_COMMON + [
+            "geometry: the square (0,6)^2 of 3.3-ex1 becomes the cube (0,6)^3 with its y axis as "
+            "z: Gamma_D = {x = 0} and {x = 6}, Gamma_N = {z = 6} with f_N = (0, 0, -10t), "
+            "Gamma_C = {z = 0}; y = 0 and y = 6 traction-free",
+            f"structured n x n x n grid; run defaults n = {N_3_3_EX1}, k = 0.01, T = 1 (the 2-D "
+            "run's k and T); the stability check is on (warn): k_max in summary.json",
+            "maximal interpenetration over the Gamma_C vertices with each facet's outward normal "
+            "(3-D facets: normal of the triangle) in history.csv and summary.json",
+            "solvers: as in 2-D (velocity CG + Jacobi, mass-dominated; damage obstacle step "
+            "SNES vinewtonrsls, CG + Jacobi)"],
+        figures=figs("Example 3.3-1 in 3-D: von Mises stress and damage"))
+    from ..geometries.wrench_plate import wrench_plate
+    ex3_2d = _thesis_entry("section_3_3", "3.3-ex3")
+    ex33w = _from_2d(
+        ex3_2d, id="3.3-ex3-3d",
+        title="3-D: the ring wrench as a plate of thickness 0.4 on a stiff hexagonal screw, "
+              "cyclic pressure 1e5 sqrt(2)|sin(pi t)| on the end face of the handle",
+        h=H_3_3_EX3, k=K_3_3_EX3, T=T_3_3_EX3, diameter=math.sqrt(11.2 ** 2 + 2.4 ** 2 + 0.4 ** 2),
+        make_geometry=lambda comm, n, h: wrench_plate(comm, h=h, h_contact=h / 2),
+        traction=lambda x, t: ufl.as_vector((-1e5 * abs(ufl.sin(math.pi * t)),
+                                             -1e5 * abs(ufl.sin(math.pi * t)), 0.0)),
+        assumptions=_3D_COMMON + [
+            "geometry (geometries/wrench_plate.py): the G35 outline of 3.3-ex3 extruded along z "
+            "by the thickness 0.4 (half the handle width, about the proportion of a real "
+            "box-end wrench); Gamma_C = the six hexagon faces (the 2-D Gamma_C times the "
+            "thickness), Gamma_N = the extruded loaded face with f_N = (-1e5, -1e5, 0)|sin(pi t)| "
+            "(a pure pressure), all other faces (outer sides, plate faces z = 0 and z = 0.4) "
+            "traction-free; Gamma_D empty (G35/G42: the mass keeps each velocity system "
+            "definite)",
+            f"gmsh tetrahedra, h = {H_3_3_EX3} (--h), h/2 on the hexagon faces (2-D: h = 0.15, "
+            "h/3)",
+            f"1.8/G33: k = {K_3_3_EX3:g}, at most 0.8 k_max of stability.py at the default mesh "
+            "(k_max in summary.json)",
+            f"final time T = {T_3_3_EX3:g} by default (the thesis' T = 6.5 is 650 000 explicit "
+            "steps: --T 6.5 runs it; benchmarks/README.md '3-D: contact' gives the measured "
+            "cost per step)",
+            "solvers: as in 2-D (velocity CG + Jacobi with the fast matrix update in serial; "
+            "damage obstacle step SNES vinewtonrsls, CG + Jacobi)"],
+        figures=figs("Example 3.3-3 in 3-D: von Mises stress and damage in the wrench plate"))
+    return [ex23, ex31, ex33, ex33w]

@@ -1,0 +1,123 @@
+"""The ring wrench of Section 3.3 Example 3 (thesis Figure 3.19) as a plate with thickness: the
+2-D outline of ``wrench.py`` (G35: head disc R = 1.2 with a hexagonal hole across flats 1.0,
+handle [1, 10] x [-0.4, 0.4], rotated by -45 degrees) extruded along z by ``thickness`` (issue 17).
+
+Thickness 0.4 by default: half the handle width, about the proportion of a real box-end wrench
+(a 13 mm wrench, the unit here being the across-flats size of the screw, is about 5-6 mm thick
+with a 10-11 mm wide handle). The plate spans 0 <= z <= thickness.
+
+Facet tags, the extrusions of the 2-D parts: GAMMA_C = the six hexagon faces (the sides of the
+hole, in contact with the rigid screw; outward normal pointing into the hole), GAMMA_N = the
+loaded face (the extruded top of the handle for x in [9, 10] in the local frame, outward normal
+(1, 1, 0)/sqrt(2)), FREE = everything else (the outer sides and the two plate faces z = 0 and
+z = thickness), traction-free. Gamma_D is empty (G35, G42). Element size ``h`` (0.2),
+``h_contact`` (0.1) on the hexagon faces, growing to h over ``transition`` (0.5). Meshed on
+rank 0 (gmsh, tetrahedra) and distributed.
+"""
+from __future__ import annotations
+
+import math
+
+import gmsh
+
+from damage_dolfinx import compat
+from damage_dolfinx.parameters import InputError
+
+from . import GAMMA_C, GAMMA_N, Geometry, gmsh_session
+from .wrench import FREE, _build, _check
+
+__all__ = ["wrench_plate", "FREE"]
+
+
+def wrench_plate(comm, h: float = 0.2, h_contact: float = 0.1, thickness: float = 0.4,
+                 head_radius: float = 1.2, across_flats: float = 1.0, handle_start: float = 1.0,
+                 handle_end: float = 10.0, handle_width: float = 0.8, load_start: float = 9.0,
+                 rotation_deg: float = -45.0, hex_angle_deg: float = 0.0,
+                 transition: float = 0.5) -> Geometry:
+    """The G35 wrench extruded to a plate, as a :class:`Geometry` (facet tags GAMMA_C, GAMMA_N,
+    FREE)."""
+    _check(head_radius, across_flats, handle_start, handle_end, handle_width, load_start)
+    if not (h > 0 and h_contact > 0 and thickness > 0):
+        raise InputError(f"mesh sizes and thickness must be positive, got h = {h}, "
+                         f"h_contact = {h_contact}, thickness = {thickness}")
+    error = None
+    if comm.rank == 0:
+        try:
+            gmsh_session()
+            gmsh.model.add("wrench_plate")
+            surfaces = _build(head_radius, across_flats, handle_start, handle_end, handle_width,
+                              load_start, hex_angle_deg, rotation_deg)
+            gmsh.model.occ.extrude(surfaces, 0, 0, thickness)
+            gmsh.model.occ.synchronize()
+            volumes = gmsh.model.getEntities(3)
+            faces = [t for _, t in gmsh.model.getBoundary(volumes, combined=True, oriented=False)]
+            hexagon, loaded = _classify(faces, across_flats, handle_width, load_start,
+                                        handle_end, rotation_deg, thickness)
+            gmsh.model.addPhysicalGroup(3, [t for _, t in volumes], 1)
+            gmsh.model.addPhysicalGroup(2, hexagon, GAMMA_C)
+            gmsh.model.addPhysicalGroup(2, loaded, GAMMA_N)
+            gmsh.model.addPhysicalGroup(2, sorted(set(faces) - set(hexagon) - set(loaded)), FREE)
+            _mesh_sizes(hexagon, h, h_contact, transition)
+            gmsh.model.mesh.generate(3)
+        except Exception as exc:  # reported on every rank, not only where gmsh runs
+            error = f"wrench plate geometry: {exc}"
+            gmsh.model.remove()
+    error = comm.bcast(error, root=0)
+    if error is not None:
+        raise InputError(error)
+    msh, _, facet_tags = compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    return Geometry(msh, facet_tags, h=h,
+                    description=f"ring wrench plate (G35 outline extruded by {thickness}): head "
+                                f"R={head_radius}, hexagon across flats {across_flats}, handle "
+                                f"[{handle_start},{handle_end}]x[-{handle_width / 2},"
+                                f"{handle_width / 2}], load on x in [{load_start},{handle_end}], "
+                                f"rotated {rotation_deg} deg; gmsh h={h}, h_contact={h_contact}")
+
+
+def _classify(faces, across_flats, handle_width, load_start, handle_end, rotation_deg,
+              thickness):
+    """(hexagon faces, loaded faces): side faces (centre of mass at mid-thickness) by the point
+    at the middle of their parameter range (on the face: a curved face's centre of mass is not)
+    mapped back to the local frame, as the 2-D wrench classifies its curves."""
+    c, s = math.cos(math.radians(rotation_deg)), math.sin(math.radians(rotation_deg))
+    w2, tol = handle_width / 2, 1e-6 * handle_end
+    hexagon, loaded = [], []
+    for tag in faces:
+        if abs(gmsh.model.occ.getCenterOfMass(2, tag)[2] - thickness / 2) > tol:
+            continue  # the plate faces z = 0 and z = thickness
+        lo, hi = gmsh.model.getParametrizationBounds(2, tag)
+        X, Y, _ = gmsh.model.getValue(2, tag, [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])])
+        x, y = c * X + s * Y, -s * X + c * Y  # inverse rotation
+        if math.hypot(x, y) <= across_flats / 2 + tol:  # flat midpoints lie at the apothem
+            hexagon.append(tag)
+        elif abs(y - w2) <= tol and load_start - tol <= x <= handle_end + tol:
+            loaded.append(tag)
+    if len(hexagon) != 6 or len(loaded) != 1:
+        raise RuntimeError(f"found {len(hexagon)} hexagon faces and {len(loaded)} loaded faces "
+                           "(expected 6 and 1)")
+    return hexagon, loaded
+
+
+def _mesh_sizes(hexagon, h, h_contact, transition):
+    """Size h_contact on the hexagon faces, growing linearly to h at distance ``transition``."""
+    field = gmsh.model.mesh.field
+    dist = field.add("Distance")
+    for faces, sampling in (("SurfacesList", "Sampling"), ("FacesList", "NNodesByEdge")):
+        try:  # option names of gmsh >= 4.9, then of gmsh 4.8
+            field.setNumbers(dist, faces, hexagon)
+            field.setNumber(dist, sampling, 30)
+            break
+        except Exception:
+            continue
+    thr = field.add("Threshold")
+    field.setNumber(thr, "InField", dist)
+    field.setNumber(thr, "SizeMin", min(h_contact, h))
+    field.setNumber(thr, "SizeMax", h)
+    field.setNumber(thr, "DistMin", 0.0)
+    field.setNumber(thr, "DistMax", transition)
+    field.setAsBackgroundMesh(thr)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
