@@ -45,6 +45,8 @@ def _parser():
     run.add_argument("--k", type=float, help="time step")
     run.add_argument("--mesh", help="gmsh .msh file replacing the built-in geometry")
     run.add_argument("--write-every", type=int, help="XDMF output every N steps (default N/20)")
+    run.add_argument("--history-every", type=int, metavar="N",
+                     help="a history.csv row every N steps (default: the example's, mostly 1)")
     run.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     run.add_argument("--checkpoint-every", type=int, metavar="STEPS",
                      help="write a checkpoint every STEPS steps (default: every "
@@ -145,7 +147,7 @@ def main(argv=None):
                        write_every=args.write_every, progress=not args.quiet,
                        figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
                        checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
-                       overwrite=args.overwrite)
+                       overwrite=args.overwrite, history_every=args.history_every)
             return 0
         if args.command == "converge":
             from . import convergence

@@ -4,11 +4,12 @@
 remove or rename them):
 
     schema, example, title, section, status ("running" | "completed" | "zeta_star_reached" |
-    "failed" | "interrupted"), error (if failed), signal (if interrupted), parameters (all model parameters), n, h, k, T, num_steps
-    (planned), steps_done, t_final, mpi_size, wall_time_s, timings_s, iterations (total solver
-    iterations: damage_ksp, mech_ksp, snes), mesh (cells, vertices, dofs, h, description),
-    final (u_L2, eps_u_L2, zeta_min, zeta_max, zeta_mean at t_final), assumptions, outputs
-    (file names), environment (versions, MPI size, command, date).
+    "failed" | "interrupted"), error (if failed), signal (if interrupted), parameters (all model
+    parameters), n, h, k, T, num_steps (planned), history_every (a history.csv row every that
+    many steps), steps_done, t_final, mpi_size, wall_time_s, timings_s, iterations (total solver
+    iterations: damage_ksp, mech_ksp, snes), mesh (cells, vertices, dofs, h, description), final
+    (u_L2, eps_u_L2, zeta_min, zeta_max, zeta_mean at t_final), assumptions, outputs (file
+    names), environment (versions, MPI size, command, date).
 
 The file is rewritten (atomically) at every output time, so a killed run leaves a readable
 summary with status "running" and the CSV history of every finished step. Faults (README,
@@ -44,10 +45,14 @@ class Progress:
         self.interval, self.start, self.last = interval, time.perf_counter(), -math.inf
 
     def __call__(self, step, t, stats, scalars, force=False):
+        """``scalars``: the step's scalars, or a callable returning them (asked only when a line
+        is printed)."""
         now = time.perf_counter()
         if not self.enabled or (not force and now - self.last < self.interval and step != self.total):
             return
         self.last = now
+        if callable(scalars):
+            scalars = scalars()
         elapsed = now - self.start
         eta = elapsed / max(step, 1) * (self.total - step)
         its = " ".join(f"{k}={v}" for k, v in stats.items())
@@ -62,7 +67,7 @@ CHECKPOINT_SECONDS = 120.0
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
         write_every=None, progress=True, figures=True, time_limit=None, checkpoint_every=None,
         checkpoint_seconds=CHECKPOINT_SECONDS, restart=False, overwrite=True,
-        comm=MPI.COMM_WORLD) -> dict:
+        history_every=None, comm=MPI.COMM_WORLD) -> dict:
     """Run one catalogue example and write its outputs to ``out``; returns the summary.
     With ``time_limit`` (seconds) the run stops after the step that exceeds it, with status
     "time_limit" (used by benchmarks that skip cells a solver cannot finish).
@@ -75,9 +80,22 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     the checkpoint. A folder holding a run is refused (InputError) unless ``restart`` or
     ``overwrite`` (the command line passes overwrite=False unless --overwrite); a folder where a
     run is live is always refused (runfolder.RunLock). Output errors raise io.OutputError, signals
-    RunInterrupted, both after recording the status in summary.json."""
+    RunInterrupted, both after recording the status in summary.json.
+
+    History cadence (issue 18): ``history_every`` (default: the example's parameter
+    ``history_every``, else 1) writes a history.csv row every that many steps, plus the first,
+    the last and a stopping step. In between, the stepper only updates what summary.json reports
+    over all steps (``stepper.track()``: the 3.3 maximal interpenetration, its time and place;
+    a stepper without it computes its scalars), and the summary's other scalars are brought up
+    to date before each output, checkpoint or stop."""
     ex = examples.get(example_id, (overrides or {}).get("reading"))
     configured = ex.configure(n, k, T, h, overrides, mesh_file)
+    every = history_every if history_every is not None else \
+        configured[0].extra.get("history_every", 1)
+    if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
+            or every < 1:
+        raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
+    every = int(every)
     if restart and not Path(out).is_dir():
         raise InputError(f"cannot restart: no checkpoint in {str(out)!r} (no such folder)")
     out = io.prepare_output_dir(out, comm)
@@ -86,13 +104,14 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         with StopSignals() as signals:
             return _run(ex, configured, out, n, k, T, h, overrides, write_every, progress,
                         figures, time_limit, checkpoint_every, checkpoint_seconds, restart,
-                        overwrite, comm, signals, lock)
+                        overwrite, comm, signals, lock, every)
     finally:
         lock.release()
 
 
 def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figures, time_limit,
-         checkpoint_every, checkpoint_seconds, restart, overwrite, comm, signals, lock) -> dict:
+         checkpoint_every, checkpoint_seconds, restart, overwrite, comm, signals, lock,
+         history_every=1) -> dict:
     wall_start = time.perf_counter()
     params, grid, n, h, mesh_file = configured
     settings = {"example": ex.id, "n": n, "h": h, "k": grid.k, "overrides": overrides or {},
@@ -139,6 +158,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     summary = {"schema": "damage-dolfinx/summary/v1", "example": ex.id, "title": ex.title,
                "section": ex.section, "status": "running", "parameters": params.as_dict(),
                "n": n, "h": stepper.data.geometry.h, "k": grid.k, "T": grid.T, "num_steps": N,
+               "history_every": history_every,
                "steps_done": 0, "t_final": 0.0, "mpi_size": comm.size,
                "mesh": stepper.mesh_info(), "assumptions": ex.assumptions,
                "outputs": {"xdmf": "fields.xdmf", "history": "history.csv",
@@ -157,6 +177,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     io.collective(comm, out, f"{xdmf_name} / history.csv (opening)", open_files)
     xdmf, history = files["xdmf"], files["history"]
     report = Progress(ex.id, N, comm, enabled=progress)
+    # steppers without track() compute their scalars (whatever they keep track of stays right)
+    track = getattr(stepper, "track", None) or stepper.scalars
     previous_wall = resume["wall_time_s"] if resume else 0.0
     if resume:
         summary["restarts"] = resume.get("restarts", []) + [
@@ -197,15 +219,25 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             return stepper.n % checkpoint_every == 0
         return bool(checkpoint_seconds) and since_checkpoint > checkpoint_seconds
 
-    def record(stats, step_time):
+    recorded = {"step": None}
+
+    def record(stats, step_time, row=True):
+        """The step's scalars into the summary and (``row``) a history.csv row."""
         scalars = stepper.scalars()
-        history.write({"step": stepper.n, "t": stepper.t, **scalars, **stats,
-                       "step_time_s": f"{step_time:.4g}"})
+        if row:
+            history.write({"step": stepper.n, "t": stepper.t, **scalars, **stats,
+                           "step_time_s": f"{step_time:.4g}"})
+        recorded["step"] = stepper.n
         summary.update(steps_done=stepper.n, t_final=stepper.t, final=scalars,
                        iterations=stepper.iteration_totals(),
                        wall_time_s=previous_wall + time.perf_counter() - wall_start,
                        **stepper.summary_extra())
         return scalars
+
+    def up_to_date(stats, step_time):
+        """The summary of the current step (a step between history rows has none yet)."""
+        if recorded["step"] != stepper.n:
+            record(stats, step_time, row=False)
 
     def write_fields():
         stepper.update_output()
@@ -254,16 +286,27 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         while stepper.n < N:
             start = time.perf_counter()
             stats = stepper.advance()
-            scalars = record(stats, time.perf_counter() - start)
+            step_time = time.perf_counter() - start
+            row = stepper.n % history_every == 0 or stepper.n == N
+            if row:
+                scalars = record(stats, step_time)
+            else:  # between history rows: only the extremes over all steps (issue 18)
+                track()
+                scalars = stepper.scalars
             since_checkpoint, elapsed, signum = end_of_step()
             if signum and stepper.n < N:
+                up_to_date(stats, step_time)
                 interrupt(signum)
             stop = stepper.stop_reason()
             if time_limit and elapsed > time_limit:
                 stop = stop or "time_limit"
+            if stop and not row:  # the stopping step always has its row
+                scalars = record(stats, step_time)
             if stop or stepper.n % write_every == 0 or stepper.n == N:
+                up_to_date(stats, step_time)
                 write_fields()
             if (stop and stepper.n < N) or checkpoint_due(since_checkpoint):
+                up_to_date(stats, step_time)
                 save_checkpoint()
             timed_figures()
             report(stepper.n, stepper.t, stats, scalars, force=bool(stop))

@@ -253,3 +253,62 @@ def test_fast_velocity_rhs_equals_assembly():
         d = np.abs(fast - s.mech.b.array).max() / np.abs(s.mech.b.array).max()
         print(f"fast right-hand side vs assembly: relative difference {d:.1e}")
         assert d < 1e-13
+
+
+WRENCH = ["run", "3.3-ex3", "--h", "0.5", "--k", "1e-5", "--no-figures", "--quiet"]
+
+
+def _rows(out):
+    import csv
+    with open(out / "history.csv") as f:
+        return {int(r["step"]): {k: v for k, v in r.items() if k != "step_time_s"}
+                for r in csv.DictReader(f)}
+
+
+def test_history_cadence_and_restart(tmp_path):
+    """Issue 18: with --history-every 7 the rows are those of the run with a row per step at
+    steps 0, 7, 14, ... and the last, every value equal; the maximal interpenetration over all
+    steps (tracked between rows) and the final state are the same. A run stopped at step 15
+    and continued with --restart ends with the same rows (plus its row at 15), fields and
+    maximum."""
+    run_cli(WRENCH + ["--T", "3e-4", "--history-every", "1", "--out", tmp_path / "all"])
+    run_cli(WRENCH + ["--T", "3e-4", "--history-every", "7", "--out", tmp_path / "every7"])
+    run_cli(WRENCH + ["--T", "1.5e-4", "--history-every", "7", "--out", tmp_path / "resumed"])
+    run_cli(WRENCH + ["--T", "3e-4", "--history-every", "7", "--restart",
+                      "--out", tmp_path / "resumed"])
+    every, sparse, resumed = (_rows(tmp_path / d) for d in ("all", "every7", "resumed"))
+    assert sorted(sparse) == [0, 7, 14, 21, 28, 30]
+    assert all(sparse[n] == every[n] for n in sparse)
+    assert sorted(resumed) == sorted(set(sparse) | {15})
+    assert all(resumed[n] == every[n] for n in resumed)
+    (s_all, f_all), (s_7, f_7), (s_r, f_r) = (load_run(tmp_path / d)
+                                              for d in ("all", "every7", "resumed"))
+    assert s_7["history_every"] == 7 and s_all["history_every"] == 1
+    for s in (s_7, s_r):
+        for key in ("max_penetration", "max_penetration_t", "max_penetration_at", "final"):
+            assert s[key] == s_all[key], key
+    assert all(np.array_equal(f_r[name], f_all[name]) for name in ("u", "zeta", "v"))
+    assert s_all["max_penetration"] > 0
+
+
+def test_contact_maximum_is_checkpointed():
+    """The maximal interpenetration so far (value, time, place) goes into the checkpoint state
+    and comes back on restore(), so a resumed run reports the maximum over the whole run."""
+    from damage_dolfinx import examples
+    build = lambda: examples.get("3.3-ex3").build(  # noqa: E731
+        MPI.COMM_WORLD, h=0.5, k=1e-5, T=1e-4, overrides={"stability_check": "off"})
+    s = build()
+    s.initialize()
+    for _ in range(10):
+        s.advance()
+        s.track()
+    worst = s.contact.summary()
+    assert worst["max_penetration"] > 0 and worst["max_penetration_t"] > 0
+    state = {name: (f.copy() if isinstance(f, np.ndarray) else f.x.array.copy())
+             for name, f in s.checkpoint_state().items()}
+    fresh = build()
+    target = fresh.checkpoint_state()
+    for name, f in target.items():
+        (f if isinstance(f, np.ndarray) else f.x.array)[...] = state[name]
+    fresh.restore(10)
+    assert fresh.contact.summary() == worst and fresh.probe.first_zeta_star_time is None
