@@ -48,12 +48,21 @@ def sample_plane(fn, axis: int, value: float, lo, hi, res=RESOLUTION):
     return s, t, values.reshape(S.shape)
 
 
+#: a body whose smallest extent is below this fraction of its largest is a plate: one section
+THIN = 0.2
+
+
 def default_planes(msh):
     """Sections through the middle of the bounding box: z = mid (horizontal), y = mid, moved by
     1e-7 of the extent so that a section on a face of the mesh shows the cells on one side of it
-    (cell-wise fields are two-valued on a face)."""
+    (cell-wise fields are two-valued on a face). A plate (smallest extent < THIN x largest, e.g.
+    the wrench plate) gets its mid-plane only: the other sections would be thin strips."""
     lo, hi = _bounds(msh)
     mid = 0.5 * (lo + hi) + 1e-7 * (hi - lo)
+    extent = hi - lo
+    if extent.min() < THIN * extent.max():
+        axis = int(np.argmin(extent))
+        return [(axis, float(mid[axis]))]
     return [(2, float(mid[2])), (1, float(mid[1]))]
 
 

@@ -9,8 +9,8 @@ and damage (PDE form, variant A), scheme (2.136)-(2.137).
 p_nu(r) = c_nu r_+ (semismooth Newton, SNES prefix ``mech_``); damage PDE step prefix
 ``damage_`` (matrix factorised once). The dimension comes from the mesh (issue 17): on a 3-D mesh
 B is 3-D Hooke, M_n a 3x3 tensor, Gamma_C any plane or curved face; from
-``scalable.DIRECT_MAX_DOFS_3D`` unknowns on, Newton's linear systems are solved by CG + GAMG
-with the rigid-body near-nullspace (the AMG hierarchy lagged like the factorisation in 2-D) and
+``scalable.DIRECT_MAX_DOFS_3D`` unknowns on, Newton's linear systems are solved by CG +
+BoomerAMG (``mech_contact_amg``; the AMG set-up lagged like the factorisation in 2-D) and
 the damage PDE by CG + BoomerAMG. The memory term is updated in O(1) per step for constant
 and exponential kernels (memory.py).
 """
@@ -36,6 +36,17 @@ from .base import ProblemData, TimeStepper
 
 #: Krylov iterations above which the lagged Jacobian factorisation is rebuilt
 MECH_REFACTOR_ITS = 10
+
+
+def mech_contact_amg():
+    """Newton defaults of the 3-D displacement step at size: CG + hypre BoomerAMG (where PETSc
+    has hypre; None otherwise: the lagged direct solve). GAMG, the elasticity default of
+    scalable.py, fails here: with the near-rigid foundation (c_nu = 1e10 against E = 100) its
+    Chebyshev/Jacobi smoother gave an indefinite preconditioner once the contact term was active
+    (2.3-ex1-3d, n = 10 and 20), with SOR smoothing a failed level solve at n = 20; BoomerAMG
+    took 8-14 CG iterations per Newton step at n = 10 and 20 (benchmarks/README.md "3-D:
+    contact")."""
+    return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
 
 
 class ViscoelasticMemoryContact(TimeStepper):
@@ -76,9 +87,9 @@ class ViscoelasticMemoryContact(TimeStepper):
                                   self.c_nu, self.gap, self.n_facet, f_B, f_N, ds(GAMMA_N),
                                   ds(GAMMA_C))
         bc = clamped(V, tags, GAMMA_D)
-        if scalable.iterative(V):  # 3-D at size: CG + GAMG, hierarchy rebuilt as P is
+        if scalable.iterative(V) and mech_contact_amg():  # 3-D at size: CG + BoomerAMG
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
-                                        defaults={**NEWTON, **scalable.MECH_AMG},
+                                        defaults=mech_contact_amg(),
                                         refactor_after_its=scalable.MECH_AMG_REBUILD_ITS)
             J, P = self.mech.snes.snes.getJacobian()[:2]
             modes = scalable.rigid_body_modes(V)
