@@ -207,6 +207,25 @@ def create_box(comm, p0, p1, n):
                             dmesh.CellType.tetrahedron)
 
 
+def create_tet_mesh(comm, cells, x):
+    """P1 tetrahedral mesh from this rank's cells (int64 global vertex numbers) and this rank's
+    block of vertex coordinates ``x`` (rank r's rows are the vertices offset_r, offset_r + 1, ...,
+    offsets in rank order), partitioned and ghosted (shared facets) like ``create_box``."""
+    mode = dmesh.GhostMode.shared_facet
+    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 4)
+    x = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+    if "domain" in inspect.signature(dmesh.create_mesh).parameters:  # 0.5-0.6
+        domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.tetrahedron, 1))
+        return dmesh.create_mesh(comm, cells, x, domain, ghost_mode=mode)
+    import basix.ufl
+    domain = ufl.Mesh(basix.ufl.element("Lagrange", "tetrahedron", 1, shape=(3,)))
+    try:
+        partitioner = dmesh.create_cell_partitioner(mode, 2)  # 0.10+: max facet-cell links
+    except TypeError:
+        partitioner = dmesh.create_cell_partitioner(mode)
+    return dmesh.create_mesh(comm, cells=cells, x=x, e=domain, partitioner=partitioner)
+
+
 def create_submesh(msh, dim, entities):
     """Submesh of the given entities; returns the mesh only (maps differ between versions)."""
     out = dmesh.create_submesh(msh, dim, entities)
