@@ -84,6 +84,20 @@ def tensor_dg0(msh):
     return function_space(msh, "DG", 0, (d, d))
 
 
+def facet_vertex_quadrature() -> dict:
+    """Integration metadata of the vertex rule on the triangular facets of a tetrahedral mesh
+    (nodal quadrature of a 3-D boundary integral, issue 17). FFCx 0.9+ applies its "vertex"
+    scheme to the facet; FFCx 0.5 applies it to the cell (tetrahedron points on a facet) and
+    Basix has no GLL rule on triangles, so there the rule is given explicitly: weight 1/6 (a
+    third of the reference triangle's area) at each vertex."""
+    major, minor = (int(part) for part in ffcx.__version__.split(".")[:2])
+    if (major, minor) >= (0, 9):
+        return {"quadrature_rule": "vertex", "quadrature_degree": 1}
+    return {"quadrature_rule": "custom", "quadrature_degree": 1,
+            "quadrature_points": ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)),
+            "quadrature_weights": (1.0 / 6.0,) * 3}
+
+
 # ---------------------------------------------------------------------------- vectors
 def petsc_vec(u: fem.Function) -> PETSc.Vec:
     """The PETSc vector that wraps a Function's dof array (ghosted)."""
