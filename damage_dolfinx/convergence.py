@@ -26,30 +26,94 @@ from .runner import Progress
 
 
 class _CoarseRun:
-    """One coarse (n, k) run: its error components transferred to the reference mesh."""
+    """One coarse (n, k) cell: its stepper (on the ranks that run it) and its error components
+    transferred to the reference mesh.
 
-    def __init__(self, stepper, ref, n, k, ratio, norms):
-        self.stepper, self.n, self.k, self.ratio, self.norms = stepper, n, k, ratio, norms
-        self.h = stepper.data.geometry.h
-        grid = stepper.data.geometry.grid
+    ``owner`` None: the cell runs on all ranks of the study (large cells). Otherwise it runs
+    serially on rank ``owner`` (``stepper`` is None on the other ranks), which sends the grid
+    values of its components to the ranks of the reference mesh at each measurement.
+    """
+
+    def __init__(self, n, k, ratio, owner, stepper):
+        self.n, self.k, self.ratio, self.owner, self.stepper = n, k, ratio, owner, stepper
+        self.err_parts, self.err, self.err_T, self.wall = {}, 0.0, 0.0, 0.0
+
+    @property
+    def mine(self) -> bool:
+        return self.stepper is not None
+
+    def connect(self, ref, grid, h, transfers, norms, comm):
+        """Set up the measurement against ``ref`` (collective on ``comm``, the reference's)."""
+        self.h, self.comm, self.norms = h, comm, norms
+        coarse = dict((name, f) for name, f, _ in self.stepper.error_components) \
+            if self.mine else {}
         self.components = []
-        for (name, f, _), (_, f_ref, _) in zip(stepper.error_components, ref.error_components):
-            self.components.append((name, post.nested_transfer(f.function_space,
-                                                                f_ref.function_space, grid),
-                                    f, fem.Function(f_ref.function_space)))
+        for name, f_ref, _ in ref.error_components:
+            fine_side = transfers(grid, f_ref.function_space)
+            f = coarse.get(name)
+            coarse_side = post.nested_transfer(f.function_space, None, grid) \
+                if f is not None else None
+            self.components.append((name, fine_side, coarse_side, f,
+                                    fem.Function(f_ref.function_space)))
         self.err_parts = {name: 0.0 for name, *_ in self.components}
-        self.err = self.err_T = 0.0
-        self.wall = 0.0
+
+    def advance(self, initial=False):
+        start = time.perf_counter()
+        self.stepper.initialize() if initial else self.stepper.advance()
+        self.wall += time.perf_counter() - start
 
     def measure(self):
+        """Error at the current common time level; collective on the reference's ranks."""
         total = 0.0
-        for name, transfer, f, f_fine in self.components:
-            transfer(f, f_fine)
+        for name, fine_side, coarse_side, f, f_fine in self.components:
+            if self.owner is None:
+                on_grid = coarse_side.grid_values(f)
+            else:
+                on_grid = coarse_side.grid_values(f) if self.mine else \
+                    np.empty(fine_side.grid_shape)
+                self.comm.Bcast(on_grid, root=self.owner)
+            fine_side.to_fine(on_grid, f_fine)
             e = self.norms[name](f_fine)
             self.err_parts[name] = max(self.err_parts[name], e)
             total += e
         self.err = max(self.err, total)
         self.err_T = total  # the last measurement is at t = T
+
+
+#: coarse cells with at most this many mesh cells per side run serially, shared out among
+#: the ranks (a 2-rank step of a small mesh is slower than a serial one); larger cells, like
+#: the reference, run on all ranks
+SERIAL_CELL_MAX_N = 64
+
+
+def _owners(ns, ks, T, size, serial_max_n=SERIAL_CELL_MAX_N) -> dict:
+    """(n, k) -> rank that runs the cell serially, or None (all ranks). The serial cells of each
+    k (they step at the same time levels) are shared out greedily by cost, steps x vertices,
+    to the rank with the least work in that k, then in total: the ranks wait for each other at
+    every reference step, so the balance must hold per time level, not only on the sum."""
+    owners, total = {}, np.zeros(size)
+    for k in ks:
+        in_k = np.zeros(size)
+        for n in sorted(ns, reverse=True):
+            if size == 1 or n > serial_max_n:
+                owners[(n, k)] = None
+                continue
+            rank = min(range(size), key=lambda r: (in_k[r], total[r]))
+            cost = (T / k) * (n + 1) ** 2
+            in_k[rank] += cost
+            total[rank] += cost
+            owners[(n, k)] = rank
+    return owners
+
+
+def _cell_geometry(runs, comm):
+    """{(n, k): (grid, h)} of every cell on every rank (each rank knows its own cells')."""
+    mine = {(r.n, r.k): (r.stepper.data.geometry.grid, r.stepper.data.geometry.h)
+            for r in runs if r.mine and (r.owner is None and comm.rank == 0 or r.owner is not None)}
+    out = {}
+    for part in comm.allgather(mine):
+        out.update(part)
+    return out
 
 
 def _component_norms(ref):
@@ -75,7 +139,7 @@ def _check_nested(ref_n, ref_k, ns, ks):
 
 
 def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, overrides=None,
-          progress=True, comm=MPI.COMM_WORLD) -> dict:
+          progress=True, comm=MPI.COMM_WORLD, serial_max_n=SERIAL_CELL_MAX_N) -> dict:
     """Run the study; returns the summary (errors per (n, k), fitted rates, wall times)."""
     wall_start = time.perf_counter()
     ex = examples.get(example_id, (overrides or {}).get("reading"))
@@ -96,29 +160,57 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
 
     ref = ex.build(comm, n=ref_n, k=ref_k, T=T, overrides=overrides)
     norms = _component_norms(ref)
-    runs = [_CoarseRun(ex.build(comm, n=n, k=k, T=T, overrides=overrides), ref, n, k,
-                       int(round(k / ref_k)), norms) for n in ns for k in ks]
+    owners = _owners(ns, ks, T, comm.size, serial_max_n)
+    runs = []
+    for n in ns:
+        for k in ks:
+            owner = owners[(n, k)]
+            stepper = None
+            if owner is None:
+                stepper = ex.build(comm, n=n, k=k, T=T, overrides=overrides)
+            elif owner == comm.rank:
+                stepper = ex.build(MPI.COMM_SELF, n=n, k=k, T=T, overrides=overrides)
+            runs.append(_CoarseRun(n, k, int(round(k / ref_k)), owner, stepper))
+    geometry = _cell_geometry(runs, comm)
+    fine_sides = {}
+
+    def transfers(grid, V_fine):  # the fine half of a transfer, shared by the cells of one n
+        key = (grid.nx, grid.ny, id(V_fine))
+        if key not in fine_sides:
+            fine_sides[key] = post.nested_transfer(None, V_fine, grid)
+        return fine_sides[key]
+
+    for run in runs:
+        run.connect(ref, *geometry[(run.n, run.k)], transfers, norms, comm)
     report = Progress(f"{ex.id} converge", ref.num_steps, comm, enabled=progress, interval=10.0)
 
     ref_wall = time.perf_counter()
     stats = ref.initialize()
     ref_wall = time.perf_counter() - ref_wall
     for run in runs:
-        start = time.perf_counter()
-        run.stepper.initialize()
-        run.wall += time.perf_counter() - start
+        if run.mine:
+            run.advance(initial=True)
+    for run in runs:
         run.measure()
     while ref.n < ref.num_steps:
         start = time.perf_counter()
         stats = ref.advance()
         ref_wall += time.perf_counter() - start
-        for run in runs:
-            if ref.n % run.ratio == 0:
-                start = time.perf_counter()
-                run.stepper.advance()
-                run.wall += time.perf_counter() - start
-                run.measure()
-        report(ref.n, ref.t, stats, ref.scalars())
+        due = [run for run in runs if ref.n % run.ratio == 0]
+        for run in due:  # serial cells first: no rank waits for the other inside a parallel one
+            if run.mine and run.owner is not None:
+                run.advance()
+        for run in due:
+            if run.owner is None:
+                run.advance()
+        for run in due:
+            run.measure()
+        report(ref.n, ref.t, stats, ref.scalars() if progress else None)
+    cell_wall = comm.allreduce(np.array([r.wall if r.mine and (r.owner is not None or
+                                                               comm.rank == 0) else 0.0
+                                         for r in runs]), op=MPI.SUM)
+    for run, wall in zip(runs, cell_wall):
+        run.wall = float(wall)
 
     definition = _error_definition(ref.error_components)
     rows = [{"n": r.n, "h": r.h, "k": r.k, "h_plus_k": r.h + r.k, "error": r.err,
@@ -130,6 +222,8 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
                "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
                "error_definition": definition,
                "errors": rows, "rates": rates, "rates_at_T": rates_T, "mpi_size": comm.size,
+               "serial_cells": {"max_n": serial_max_n if comm.size > 1 else None,
+                                "rank_of_cell": [[r.n, r.k, r.owner] for r in runs]},
                "reference": {"wall_time_s": ref_wall, "mesh": ref.mesh_info(),
                              "final": ref.scalars(), "iterations": ref.iteration_totals()},
                "parameters": ref.params.as_dict(), "assumptions": ex.assumptions,
