@@ -43,6 +43,17 @@ the tangential displacement across it (``section_rotation``); a hinge's rotation
 step is the jump of that slope across +- one hinge separation. A hinge belongs to the mechanism
 if it rotates by at least ``hinge_rotation`` (default 0.2) x the largest hinge rotation; its
 opening face is the extrados if the jump is positive, the intrados otherwise.
+
+3-D (issue 17, the barrel vault of geometries/vault.py, example 2.1-ex3-vault): the dimension
+comes from the mesh. The ring is extruded along z by a width W; P is a line load per metre of
+width on the extruded load strip (traction 1000 P / L_N, L_N = strip area / W, so the total load
+is P W); self weight (0, -rho g, 0). A cross-section is the plane theta = theta_j (grid line j
+times the width) and everything above is computed over its nodes: collapse when all of them reach
+zeta_star, D_j the mean over the plane, the rotation the slope fitted to all its nodes (every grid
+layer has the same radii, so this is the mean over the width). A hinge *line* is a peak of D_j;
+per hinge the spread across the width (D and the rotation per grid layer) is reported, and at
+collapse the summary keeps D per (section, layer) and zeta on the unrolled intrados and extrados
+(hinge_lines.py draws them). 2-D runs are unchanged (bit for bit).
 """
 from __future__ import annotations
 
@@ -143,6 +154,7 @@ class BridgeDamage(ElasticDamage):
         extra = {**BRIDGE_DEFAULTS, **data.params.extra}
         check_bridge_parameters(extra)
         self.bridge = extra
+        self.width = float(getattr(geo, "width", 1.0))  # 2-D: unit out-of-plane thickness
         super().__init__(data, **kwargs)
         self._bound_damage(kwargs.get("damage_prefix", "damage_"))
         self._setup_sections(geo)
@@ -165,18 +177,22 @@ class BridgeDamage(ElasticDamage):
 
     # -- loads (G3)
     def loads(self):
-        """f_B = (0, -rho g), f_N = (0, -1000 P(t)/|Gamma_N|) N/m^2 with P(t) = load_rate t kN."""
+        """f_B = (0, -rho g[, 0]), f_N = (0, -1000 P(t)/L_N[, 0]) N/m^2 with P(t) = load_rate t
+        kN (per metre of width) and L_N the patch length (in 3-D the strip's area / width)."""
         msh = self.mesh
-        msh.topology.create_connectivity(1, 2)
+        gdim = msh.topology.dim
+        msh.topology.create_connectivity(gdim - 1, gdim)
         self._dsN = ufl.Measure("ds", domain=msh, subdomain_data=self.data.geometry.facet_tags)(GAMMA_N)
-        self.patch_length = compat.assemble_scalar(fem.Constant(msh, 1.0) * self._dsN, self.comm)
-        if not self.patch_length > 0:
+        self.patch_measure = compat.assemble_scalar(fem.Constant(msh, 1.0) * self._dsN, self.comm)
+        if not self.patch_measure > 0:
             raise InputError("the arch mesh has no load patch (facet tag GAMMA_N)")
+        self.patch_length = self.patch_measure / self.width
         weight = self.bridge["rho"] * self.bridge["gravity"]
+        zero = (0.0,) * (gdim - 2)  # the width direction z of the 3-D vault
         # fem.Constants (not floats) so that a zero load still gives a well-formed UFL form
-        f_B = fem.Constant(msh, np.array([0.0, -weight], dtype=compat.ScalarType))
+        f_B = fem.Constant(msh, np.array([0.0, -weight, *zero], dtype=compat.ScalarType))
         rate = fem.Constant(msh, 1000.0 * self.bridge["load_rate"] / self.patch_length)
-        f_N = ufl.as_vector((0.0, -rate * self.t_const))
+        f_N = ufl.as_vector((0.0, -rate * self.t_const, *zero))
         return f_B, f_N
 
     def load_kN(self, t=None) -> float:
@@ -206,6 +222,13 @@ class BridgeDamage(ElasticDamage):
         self._dphi = np.zeros(ns)
         count = np.bincount(self._sec_j, minlength=ns).astype(np.int64)
         self.section_nodes = _allreduce(self.comm, count, MPI.SUM)
+        # 3-D vault: key j * n_layers + l of (section, grid layer across the width): hinge lines
+        self._n_layers = geo.n_width + 1 if hasattr(geo, "layer_index") else 1
+        self._sec_jl = self._sec_j * self._n_layers + (
+            geo.layer_index(x[keep]) if self._n_layers > 1 else 0)
+        self._layer_nodes = _allreduce(self.comm, np.bincount(
+            self._sec_jl, minlength=ns * self._n_layers).astype(np.int64), MPI.SUM)
+        self._dphi_layers = np.zeros((ns, self._n_layers))
         # intrados / extrados node of each section (face of the first damage)
         tol = 1e-6 * geo.r_out
         self._on_in = np.abs(r - geo.r_in) < tol
@@ -229,20 +252,35 @@ class BridgeDamage(ElasticDamage):
         np.minimum.at(z_in, j[self._on_in], z[self._on_in])
         np.minimum.at(z_out, j[self._on_out], z[self._on_out])
         c = self.comm
-        return {"zeta_max": _allreduce(c, zmax, MPI.MAX), "zeta_min": _allreduce(c, zmin, MPI.MIN),
-                "damage": 1.0 - _allreduce(c, eta_sum, MPI.SUM) / self.section_nodes,
-                "zeta_intrados": _allreduce(c, z_in, MPI.MIN),
-                "zeta_extrados": _allreduce(c, z_out, MPI.MIN)}
+        out = {"zeta_max": _allreduce(c, zmax, MPI.MAX), "zeta_min": _allreduce(c, zmin, MPI.MIN),
+               "damage": 1.0 - _allreduce(c, eta_sum, MPI.SUM) / self.section_nodes,
+               "zeta_intrados": _allreduce(c, z_in, MPI.MIN),
+               "zeta_extrados": _allreduce(c, z_out, MPI.MIN)}
+        if self._n_layers > 1:  # 3-D: D per (section, layer across the width)
+            nl = self._n_layers
+            eta_jl = np.bincount(self._sec_jl, weights=eta, minlength=ns * nl)
+            out["damage_layers"] = (1.0 - _allreduce(c, eta_jl, MPI.SUM)
+                                    / self._layer_nodes).reshape(ns, nl)
+        return out
 
     def section_rotation(self) -> np.ndarray:
         """Per section j (global): least-squares slope d u_t/d r of the tangential displacement
         across the section, i.e. minus the rotation of the cross-section [rad]. Its jumps
-        between sections are the hinge rotations of the mechanism."""
-        ns = self.data.geometry.n_theta + 1
-        u = self.u.x.array.reshape(-1, 2)[self._sec_dofs]
+        between sections are the hinge rotations of the mechanism. In 3-D the fit pools all
+        nodes of the section plane; every grid layer has the same radii, so it is the mean of
+        the layers' slopes (the rotation averaged over the width)."""
+        return self._slopes(self._sec_j, self.data.geometry.n_theta + 1)
+
+    def layer_rotation(self) -> np.ndarray:
+        """3-D: the slope of ``section_rotation`` per (section j, grid layer l), shape (ns, nl)."""
+        ns, nl = self.data.geometry.n_theta + 1, self._n_layers
+        return self._slopes(self._sec_jl, ns * nl).reshape(ns, nl)
+
+    def _slopes(self, key, n_keys) -> np.ndarray:
+        u = self.u.x.array.reshape(-1, self.mesh.topology.dim)[self._sec_dofs, :2]
         ut = np.sum(u * self._sec_tangent, axis=1)
-        r, j = self._sec_r, self._sec_j
-        sums = np.stack([np.bincount(j, weights=w, minlength=ns)
+        r = self._sec_r
+        sums = np.stack([np.bincount(key, weights=w, minlength=n_keys)
                          for w in (np.ones_like(r), r, ut, r * r, r * ut)])
         n, sr, su, srr, sru = _allreduce(self.comm, sums, MPI.SUM)
         return (n * sru - sr * su) / (n * srr - sr * sr)
@@ -270,7 +308,7 @@ class BridgeDamage(ElasticDamage):
         rot = np.array([self._dphi[min(jj + distance, n_last)] - self._dphi[max(jj - distance, 0)]
                         for jj in j])
         rel = np.abs(rot) / max(np.abs(rot).max(), 1e-300) if rot.size else rot
-        return [{"section": int(j[i]), "s_m": round(float(pts["s"][i]), 4),
+        out = [{"section": int(j[i]), "s_m": round(float(pts["s"][i]), 4),
                  "rotation_step_mrad": round(1e3 * float(rot[i]), 6),
                  "rotation_step_relative": round(float(rel[i]), 3),
                  "mechanism": bool(rel[i] >= self.bridge["hinge_rotation"]),
@@ -279,6 +317,18 @@ class BridgeDamage(ElasticDamage):
                  "x_m": round(float(pts["x"][i]), 4), "y_m": round(float(pts["y"][i]), 4),
                  "section_damage": round(float(D[j[i]]), 4), "zeta_max": float(stats["zeta_max"][j[i]]),
                  "damaged_face": str(face[i])} for i in range(j.size)]
+        if self._n_layers > 1:  # 3-D: the hinge line across the width, layer by layer
+            for h, jj in zip(out, j):
+                D_l = stats["damage_layers"][jj]
+                rot_l = (self._dphi_layers[min(jj + distance, n_last)]
+                         - self._dphi_layers[max(jj - distance, 0)])
+                h.update(width_damage_min=round(float(D_l.min()), 4),
+                         width_damage_max=round(float(D_l.max()), 4),
+                         width_fraction_damaged=round(float(np.mean(
+                             D_l >= self.bridge["hinge_damage"])), 4),
+                         rotation_step_mrad_width=[round(1e3 * float(rot_l.min()), 6),
+                                                   round(1e3 * float(rot_l.max()), 6)])
+        return out
 
     def iteration_totals(self) -> dict:
         out = super().iteration_totals()
@@ -296,10 +346,15 @@ class BridgeDamage(ElasticDamage):
             phi = self.section_rotation()
             self._dphi = phi - (phi if self._phi_prev is None else self._phi_prev)
             self._phi_prev, self._phi_n = phi, self.n
+            if self._n_layers > 1:
+                phi_l = self.layer_rotation()
+                prev = getattr(self, "_phi_prev_layers", None)
+                self._dphi_layers = phi_l - (phi_l if prev is None else prev)
+                self._phi_prev_layers = phi_l
         weakest = int(np.argmin(stats["zeta_max"]))
         hinges = self.hinges(stats)
         self._hinges = hinges
-        u_y = compat.assemble_scalar(self._patch_uy, self.comm) / self.patch_length
+        u_y = compat.assemble_scalar(self._patch_uy, self.comm) / self.patch_measure
         self.zeta_min_run = min(self.zeta_min_run, float(stats["zeta_min"].min()))
         out.update(P_kN=self.load_kN(), u_load_y=u_y, weakest_section=weakest,
                    weakest_section_zeta_max=float(stats["zeta_max"][weakest]),
@@ -312,6 +367,14 @@ class BridgeDamage(ElasticDamage):
                             "section_damage": np.round(stats["damage"], 4).tolist(),
                             "s_m": np.round(pts["s"], 4).tolist(),
                             "angle_deg": np.round(pts["angle_deg"], 3).tolist()}
+            if self._n_layers > 1:  # 3-D: for the hinge-line maps (hinge_lines.py)
+                from ..hinge_lines import face_maps
+                z_in, z_out = face_maps(self)
+                self.failure.update(
+                    zeta_intrados=np.round(z_in, 4).tolist(),
+                    zeta_extrados=np.round(z_out, 4).tolist(),
+                    section_damage_layers=np.round(stats["damage_layers"], 4).tolist(),
+                    section_rotation_step_mrad=np.round(1e3 * self._dphi, 6).tolist())
         return out
 
     def stop_reason(self) -> Optional[str]:
@@ -320,6 +383,29 @@ class BridgeDamage(ElasticDamage):
         return super().stop_reason()
 
     def summary_extra(self) -> dict:
+        out = self._summary_2d()
+        f = self.failure
+        if self._n_layers > 1:  # the 3-D vault: loads per metre of width, hinge lines
+            geo = self.data.geometry
+            out["vault"] = {
+                "width_m": self.width, "n_width": geo.n_width, "ends": geo.ends,
+                "load": "P_kN is the line load per metre of width; total = P_kN x width_m",
+                "failure_load_total_kN": None if f is None else f["P_kN"] * self.width,
+                "nodes_per_section_layer": [int(self._layer_nodes.min()),
+                                            int(self._layer_nodes.max())],
+                "section_s_m": np.round(geo.section_points(np.arange(geo.n_theta + 1))["s"],
+                                        4).tolist(),
+                "s_load_m": round(0.5 * (geo.r_in + geo.r_out) * (geo.theta_left - math.acos(
+                    (geo.x_load - geo.centre[0]) / geo.r_out)), 4),
+                "failure_zeta_extrados": None if f is None else f["zeta_extrados"],
+                "failure_zeta_intrados": None if f is None else f["zeta_intrados"],
+                "failure_section_damage_layers": None if f is None else
+                f["section_damage_layers"],
+                "failure_section_rotation_step_mrad": None if f is None else
+                f["section_rotation_step_mrad"]}
+        return out
+
+    def _summary_2d(self) -> dict:
         geo = self.data.geometry
         f = self.failure
         hinges = self._hinges
