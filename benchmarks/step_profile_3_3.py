@@ -141,7 +141,7 @@ def floors(stepper, repeat=200) -> dict:
     if fast is not None:  # the sparse map when zeta HAS changed (the wrench keeps zeta = 1 early)
         start = time.perf_counter()
         for _ in range(20):
-            fast._last = None
+            fast.forget()
             fast.update(stepper.zeta.x.array)
         out["matrix_map_update_us"] = 1e6 * (time.perf_counter() - start) / 20
         R = compat.create_matrix(stepper.mech.a)
@@ -173,7 +173,7 @@ result = {"example": args.example, "h": args.h, "n": args.n, "k": runs["after"].
           "steps_timed": args.steps, "t_reached": runs["after"].s.t,
           "load_average": list(np.round(__import__("os").getloadavg(), 2)),
           "floor": floors(runs["after"].s),
-          "fast_matrix": {"colours": fast.fast.colours, "G_nnz": int(fast.fast.G.nnz)}
+          "fast_matrix": {"colours": fast.fast.colours, "P_nnz": int(fast.fast.P.nnz)}
           if hasattr(fast, "fast") else None}
 for name, p in runs.items():
     result[name] = p.split()
