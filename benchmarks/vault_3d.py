@@ -112,7 +112,19 @@ def case_record(summary):
     return rec
 
 
-def plot_sections(records, path):
+def rotation_at(summary, sections):
+    """3-D: the rotation jump in the collapse step (mrad) across +- one hinge separation at the
+    given sections (the 2-D hinges: same grid at the same h), as the stepper measures hinges."""
+    dphi = np.asarray(summary["vault"]["failure_section_rotation_step_mrad"])
+    b = summary["bridge"]
+    rc = 0.5 * (b["r_in"] + b["r_out"])
+    d = max(1, int(round(summary["hinge_definition"]["min_separation_m"]
+                         / (rc * np.pi / b["n_theta"]))))
+    n = dphi.size - 1
+    return [round(float(dphi[min(j + d, n)] - dphi[max(j - d, 0)]), 4) for j in sections]
+
+
+def plot_sections(records, path, h_mesh):
     from damage_dolfinx import figstyle
     pyplot = figstyle.plt()
     fig, ax = pyplot.subplots(figsize=(7.2, 3.8))
@@ -128,8 +140,8 @@ def plot_sections(records, path):
     ax.set_ylim(0, 1.45)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper center", fontsize=7, ncol=2)
-    figstyle.save(fig, path, title="Section damage at collapse (triangles: hinges rotating at "
-                                   "collapse)")
+    figstyle.save(fig, path, title=f"Section damage at collapse, h = {h_mesh} (triangles: "
+                                   "hinges rotating at collapse)")
 
 
 def write_md(result, path):
@@ -141,6 +153,18 @@ def write_md(result, path):
                            if h["mechanism"])
         lines.append(f"| {CASES[case][2]} | {r['cells']} | {r['failure_load_kN']} | "
                      f"{r['failure_step']} | {hinges} | {r['wall_time_s']:.1f} |")
+    rot = {c: r["rotation_at_2d_hinges"] for c, r in result["cases"].items()
+           if "rotation_at_2d_hinges" in r}
+    if rot:
+        first = next(iter(rot.values()))
+        lines += ["", "Rotation in the collapse step [mrad] at the sections where the 2-D arch "
+                  "hinges (jump of the width-averaged section rotation across +- one ring "
+                  "thickness)", "",
+                  "| case | " + " | ".join(f"{a:.0f}°" for a in first["angle_deg"]) + " |",
+                  "|---|" + "---|" * len(first["angle_deg"]),
+                  "| 2-D arch | " + " | ".join(f"{v:+.3f}" for v in first["mrad_2d"]) + " |"]
+        for c, r in rot.items():
+            lines.append(f"| {CASES[c][2]} | " + " | ".join(f"{v:+.3f}" for v in r["mrad"]) + " |")
     if result.get("stiffness"):
         lines += ["", "Self weight, u_y of the load strip: 3-D / 2-D (exact: thin ~1, plane strain "
                   "1 - nu^2)", "", "| nu | h | u_2d [mm] | thin (W = 0.05) | plane strain | "
@@ -166,7 +190,17 @@ def main():
         return
     from damage_dolfinx import hinge_lines
     ref.mkdir(parents=True, exist_ok=True)
-    result = {"h": args.h, "cases": {c: case_record(s) for c, s in summaries.items()},
+    cases = {c: case_record(s) for c, s in summaries.items()}
+    if "arch2d" in summaries:  # do the 3-D cases rotate where the 2-D arch hinges?
+        hinges2d = [h for h in summaries["arch2d"]["hinges"] if h["mechanism"]]
+        for c, s in summaries.items():
+            if "vault" in s and s["vault"]["failure_section_rotation_step_mrad"] is not None \
+                    and s["bridge"]["n_theta"] == summaries["arch2d"]["bridge"]["n_theta"]:
+                cases[c]["rotation_at_2d_hinges"] = {
+                    "angle_deg": [h["angle_deg"] for h in hinges2d],
+                    "mrad": rotation_at(s, [h["section"] for h in hinges2d]),
+                    "mrad_2d": [h["rotation_step_mrad"] for h in hinges2d]}
+    result = {"h": args.h, "cases": cases,
               "stiffness": stiff, "benchmark_wall_s": time.perf_counter() - start,
               "ranks": comm.size}
     if stiff is None and (ref / "vault_3d.json").exists():  # --plot-only keeps the old check
@@ -187,12 +221,12 @@ def main():
     reference = [(out / c / "history.csv", summaries[c].get("failure_load_kN"), CASES[c][2])
                  for c in rest]
     _plot_curves(out / first / "history.csv", summaries[first].get("failure_load_kN"),
-                 CASES[first][2], reference, ref / "load_displacement.png")
-    plot_sections(result["cases"], ref / "section_damage.png")
+                 CASES[first][2], reference, ref / "load_displacement.png", args.h)
+    plot_sections(result["cases"], ref / "section_damage.png", args.h)
     print((ref / "vault_3d.md").read_text())
 
 
-def _plot_curves(first_csv, first_fail, first_label, others, path):
+def _plot_curves(first_csv, first_fail, first_label, others, path, h_mesh):
     """All cases on one load-displacement plot (hinge_lines.plot_load_displacement, extended)."""
     from damage_dolfinx import figstyle
     from damage_dolfinx.hinge_lines import read_curve
@@ -210,7 +244,8 @@ def _plot_curves(first_csv, first_fail, first_label, others, path):
     ax.set_ylim(bottom=0)
     ax.grid(True, alpha=0.3)
     ax.legend(loc="lower right", fontsize=7, ncol=2)
-    figstyle.save(fig, path, title="Arch (2-D) and barrel vault (3-D): load-displacement")
+    figstyle.save(fig, path, title=f"Arch (2-D) and barrel vault (3-D): load-displacement, "
+                                   f"h = {h_mesh}")
 
 
 if __name__ == "__main__":
