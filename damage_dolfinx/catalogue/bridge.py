@@ -172,8 +172,8 @@ def vault_example(ex3):
             "solvers (scalable.py): elasticity CG + GAMG with the rigid-body modes, damage "
             "obstacle step SNES vinewtonrsls with CG + Jacobi",
         ],
-        figures=[Figure("vault_slices.png", "2.1-ex3-vault at collapse: sections z = W/2 (the "
-                        "arch plane) and y = const", kind="slices"),
+        figures=[Figure("vault_slices.png", "2.1-ex3-vault at collapse: section z = W/2 (the "
+                        "arch plane)", kind="slices"),
                  Figure("load_history.png", "2.1-ex3-vault: load and displacement under it",
                         fields=(("P_kN", "P [kN/m]"), ("u_load_y", "u_y under the load [m]"),
                                 ("weakest_section_zeta_max", "max zeta, weakest section")),
