@@ -1,7 +1,7 @@
 """Direct solves with J = A + diag(K) for a constant SPD matrix A and a diagonal K that lives on
 a few rows C and changes from solve to solve (issue 18).
 
-The friction Jacobians of friction.py have this form: A is the constant matrix of the velocity
+The friction Jacobians of friction/ have this form: A is the constant matrix of the velocity
 (or increment) step and K sits on the tangential dofs of the contact nodes (nodal quadrature,
 axis-parallel tangents). K changes whenever the stick set or the multipliers change, which in a
 stick-slip phase is every Newton or active-set iteration; a new Cholesky factorisation of J each
@@ -21,6 +21,10 @@ stick set: one or two Newton iterations per step), J itself is factorised once a
 stays (one triangular solve per solve, as before). Both paths are exact direct solves; they
 differ by round-off. The condensation is built lazily, at the first solve with a K other than
 the factorised one.
+
+3-D friction (issue 17) has 2x2 blocks per contact node instead of a diagonal: the condensation
+would carry over (S + D with a block-diagonal D), but it is kept 2-D only; 3-D uses
+:class:`BlockUpdateSolver` (J = A + blocks assembled, factorised or AMG-preconditioned by its KSP).
 """
 from __future__ import annotations
 
@@ -232,3 +236,58 @@ class DiagonalUpdatePC:
 
     def multTranspose(self, mat, x, y):
         self.mult(mat, x, y)
+
+
+class BlockUpdateSolver:
+    """x = (A + sum_i E_i K_i E_i^T)^{-1} b for 2x2 blocks K_i on the two tangential dofs of each
+    contact node (3-D friction, issue 17; ``rows`` (nodes, 2) local indices of owned rows).
+
+    The static condensation of :class:`DiagonalUpdateSolver` is 2-D only: here J is assembled
+    (a copy of A plus the blocks, in A's sparsity: a node's dofs are coupled there) and
+    factorised by the KSP of ``prefix`` whenever K changes. Rows that carry a Dirichlet condition
+    (``free`` False) keep A's identity row and column. ``solve(K, b, x)`` returns False when the
+    solve fails (a singular J). KSP ``defaults``: Cholesky unless given (e.g. lu_direct for a
+    non-symmetric K, or CG + GAMG with the ``near_nullspace`` of scalable.py)."""
+
+    def __init__(self, A: PETSc.Mat, rows: np.ndarray, free: np.ndarray, prefix: str,
+                 defaults=None, near_nullspace=None):
+        self.A, self.prefix = A, prefix
+        self.comm = A.getComm().tompi4py()
+        start, _ = A.getOwnershipRange()
+        self.global_rows = (start + np.asarray(rows, dtype=np.int64)).astype(PETSc.IntType)
+        self.mask = (free[:, :, None] & free[:, None, :]).astype(float)
+        self.J = A.duplicate(copy=True)
+        set_default_options(prefix, defaults or spd_direct(self.comm))
+        if near_nullspace is not None:
+            self.J.setNearNullSpace(near_nullspace)
+        self.ksp = PETSc.KSP().create(self.comm)
+        self.ksp.setOptionsPrefix(prefix)
+        self.ksp.setOperators(self.J)
+        self.ksp.setFromOptions()
+        self._K = None
+        self.factorizations = self.solves = 0
+
+    def set_K(self, K: np.ndarray):
+        """J = A + blocks K (nodes, 2, 2), re-assembled only when K changed (on some rank)."""
+        K = np.asarray(K, dtype=float) * self.mask
+        same = self._K is not None and np.array_equal(K, self._K)
+        if self.comm.allreduce(bool(same), op=MPI.LAND):
+            return
+        self.A.copy(self.J, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        for rows, block in zip(self.global_rows, K):
+            self.J.setValues(rows, rows, block, addv=PETSc.InsertMode.ADD_VALUES)
+        self.J.assemble()
+        self._K = K
+        self.factorizations += 1
+
+    def solve(self, K, b, x) -> bool:
+        self.set_K(K)
+        self.ksp.solve(b, x)
+        self.solves += 1
+        return self.ksp.getConvergedReason() > 0
+
+
+def lu_direct(comm) -> dict:
+    """Direct LU solve (a non-symmetric J): PETSc's in serial, MUMPS in parallel."""
+    package = "petsc" if comm.size == 1 else "mumps"
+    return {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": package}
