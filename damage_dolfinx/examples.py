@@ -143,7 +143,7 @@ class Example:
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
 SECTIONS = ["section_2_1", "section_2_2", "section_2_3", "bridge", "section_2_4", "section_3_1",
-            "section_3_2", "section_3_3", "section_3d"]
+            "section_3_2", "section_3_3", "section_3d", "section_3d_tresca"]
 
 
 def catalogue(reading=None) -> dict:

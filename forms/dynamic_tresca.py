@@ -9,7 +9,7 @@ second-kind VI a(v, w - v) + j(w) - j(v) >= l(w - v) that ``friction.FrictionPro
 """
 import ufl
 
-from damage_dolfinx.constitutive import B_plane_stress, Phi_L, eps, eta_star
+from damage_dolfinx.constitutive import B, Phi_L, eps, eta_star
 
 from .elastic_damage import load
 from .kelvin_voigt import viscous_stress
@@ -17,7 +17,7 @@ from .kelvin_voigt import viscous_stress
 
 def elastic_stress(u, zeta, E, nu, L_trunc, zeta_star):
     """E(eps(u), zeta) = eta_*(zeta) Phi_L(B eps(u)) (Section 3.2, (2.106) with eta_*)."""
-    return eta_star(zeta, zeta_star) * Phi_L(B_plane_stress(eps(u), E, nu), L_trunc)
+    return eta_star(zeta, zeta_star) * Phi_L(B(eps(u), E, nu), L_trunc)
 
 
 def total_stress(v, u, zeta, E, nu, m_visc, L_trunc, zeta_star):

@@ -11,7 +11,7 @@ the cell values at the centroid (interpolation into DG0 = L2 projection; tested)
 """
 import ufl
 
-from damage_dolfinx.constitutive import B_plane_stress, Phi_L, eps
+from damage_dolfinx.constitutive import B, Phi_L, eps
 
 from .elastic_damage import load
 
@@ -23,14 +23,14 @@ def viscoplastic_rate(sigma, zeta, L_trunc, sign=1.0):
 
 def stress_update(sigma_old, w, G_hat, k, E, nu):
     """sigma_n = sigma_{n-1} + k B eps(w) + k Ghat_n (2.184), evaluated cell-wise."""
-    return sigma_old + k * B_plane_stress(eps(w), E, nu) + k * G_hat
+    return sigma_old + k * B(eps(w), E, nu) + k * G_hat
 
 
 def increment_step_forms(w, v, sigma_old, G_hat, k, E, nu, f_B, f_N, dsN, S_n=None, normal=None,
                          dsC=None):
     """(a, l) of the increment VI (2.187) without j: a(w, v) = k (B eps(w), eps(v)),
     l(v) = L_n(v) - (sigma_{n-1}, eps(v)) - k (Ghat_n, eps(v)) [+ S_n (v.nu)_{Gamma_C} for P2]."""
-    a = k * ufl.inner(B_plane_stress(eps(w), E, nu), eps(v)) * ufl.dx
+    a = k * ufl.inner(B(eps(w), E, nu), eps(v)) * ufl.dx
     l = -ufl.inner(sigma_old + k * G_hat, eps(v)) * ufl.dx
     if S_n is not None:  # simplified Coulomb (2.154): prescribed normal stress on Gamma_C
         l += S_n * ufl.dot(v, normal) * dsC

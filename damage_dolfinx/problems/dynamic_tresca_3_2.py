@@ -8,7 +8,7 @@ obstacle inclusion (variant A), scheme (3.94)-(3.96):
     (3) u_n = u_{n-1} + k v_n                                                        (3.96)
 
 V = {v = 0 on Gamma_D, v.nu = 0 on Gamma_C}; j(w) = int_{Gamma_C} g |w_tau| (nodal quadrature);
-u_0 = v_0 = 0. Step (2) is the second-kind VI of friction.py with a mass term in ``a``, solved by
+u_0 = v_0 = 0. Step (2) is the second-kind VI of friction/ with a mass term in ``a``, solved by
 ``friction_solver`` (newton | uzawa | penalty-duality; prefixes ``friction_``, ``uzawa_``,
 ``pd_``). The mass term makes ``a`` coercive without Gamma_D, but Uzawa's stopping test
 (relative change in ||eps(.)||) cannot see rigid translations, so Uzawa is refused there.
@@ -27,10 +27,10 @@ from mpi4py import MPI
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from .. import compat
-from ..boundary import clamped, normal_component_zero
+from ..boundary import bilateral_plane_faces, clamped
 from ..constitutive import eps, von_mises
 from ..forms.dynamic_tresca import total_stress, velocity_step_forms
-from ..friction import FrictionProblem, iteration_counters, solver_from_parameters
+from ..friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from ..solvers import replace_default_option
 from ..stability import check_time_step, estimate_k_max
 from .base import ProblemData, TimeStepper
@@ -71,7 +71,7 @@ class DynamicTresca(TimeStepper):
         a, l = velocity_step_forms(ufl.TrialFunction(V), ufl.TestFunction(V), self.v_old,
                                    self.u_old, self.zeta_old, float(x["rho"]), self.k, p.E, p.nu,
                                    x["m_visc"], p.L_trunc, p.zeta_star, f_B, f_N, ds(GAMMA_N))
-        self.bcs = [clamped(V, tags, GAMMA_D)] + normal_component_zero(V, tags, GAMMA_C)
+        self.bcs = [clamped(V, tags, GAMMA_D)] + bilateral_plane_faces(V, tags, GAMMA_C)
         g_builder = data.builders.get("friction_bound")
         g = g_builder(ufl.SpatialCoordinate(msh)) if g_builder else fem.Constant(msh, x["g_fric"])
         self.friction_problem = FrictionProblem(self.v, a, l, self.bcs, g, ds(GAMMA_C),
@@ -134,7 +134,7 @@ class DynamicTresca(TimeStepper):
 
     def u_tau_max(self) -> dict:
         """max |u_tau| over the contact nodes of each named face (collective)."""
-        u_tau = np.abs(self.friction.nodes.tangential(self.u))
+        u_tau = law.norm(self.friction.nodes.tangential(self.u))  # |u_tau| (3-D: a vector)
         local = np.array([u_tau[i].max() if i.size else 0.0 for i in self._faces.values()])
         glob = np.empty_like(local)
         self.comm.Allreduce(local, glob, op=MPI.MAX)

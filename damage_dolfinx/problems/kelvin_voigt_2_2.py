@@ -8,7 +8,9 @@ by the obstacle inclusion (variant A), scheme (2.66)-(2.68):
     (3) u_n = u_{n-1} + k v_n                                                   (2.68)
 
 V = {v = 0 on Gamma_D, v.nu = 0 on Gamma_C}; j(w) = int_{Gamma_C} g |w_tau| (nodal quadrature).
-Step (2) by one of the three friction solvers (friction.py), chosen by the parameter
+The dimension comes from the mesh: in 3-D (issue 17) B is isotropic 3-D elasticity, w_tau a
+vector of the tangent plane of Gamma_C (faces parallel to coordinate planes).
+Step (2) by one of the three friction solvers (damage_dolfinx/friction/), chosen by the parameter
 ``friction_solver`` (newton | uzawa | penalty-duality). Prefixes: ``damage_``, ``friction_``
 (Newton), ``uzawa_``, ``pd_``.
 """
@@ -25,7 +27,7 @@ from petsc4py import PETSc
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from .. import compat
-from ..boundary import clamped, normal_component_zero
+from ..boundary import bilateral_plane_faces, clamped
 from ..constitutive import eps, von_mises
 from ..forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
 from ..friction import FrictionProblem, iteration_counters, solver_from_parameters
@@ -54,7 +56,7 @@ class KelvinVoigtTresca(TimeStepper):
         w = ufl.TestFunction(V)
         a, l = velocity_step_forms(ufl.TrialFunction(V), w, self.u_old, self.zeta_old, p.E, p.nu,
                                    x["m_visc"], p.L_trunc, f_B, f_N, ds(GAMMA_N))
-        bcs = [clamped(V, tags, GAMMA_D)] + normal_component_zero(V, tags, GAMMA_C)
+        bcs = [clamped(V, tags, GAMMA_D)] + bilateral_plane_faces(V, tags, GAMMA_C)
         g_builder = data.builders.get("friction_bound")
         g = g_builder(ufl.SpatialCoordinate(msh)) if g_builder else fem.Constant(msh, x["g_fric"])
         self.friction_problem = FrictionProblem(self.v, a, l, bcs, g, ds(GAMMA_C), self.context)
@@ -97,7 +99,7 @@ class KelvinVoigtTresca(TimeStepper):
         if point is None:
             return
         nodes = self.friction.nodes  # contact nodes, weights and tangents of the solver
-        X = self.v.function_space.tabulate_dof_coordinates()[nodes.dofs, :2]
+        X = self.v.function_space.tabulate_dof_coordinates()[nodes.dofs, :len(point)]
         dist = np.linalg.norm(X - np.asarray(point), axis=1)
         local_best = float(dist.min()) if dist.size else np.inf
         best = self.comm.allreduce(local_best, op=MPI.MIN)
@@ -119,9 +121,13 @@ class KelvinVoigtTresca(TimeStepper):
         r.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         values = np.zeros(2)
         if i is not None:
-            values[0] = self.u.x.array.reshape(-1, 2)[nodes.dofs[i], 0]
-            R = r.getArray().reshape(-1, 2)[nodes.dofs[i]]
-            values[1] = float(R @ nodes.tau[i]) / nodes.m[i]  # sigma_tau = -Phi_i = R.tau / m
+            d = nodes.dim
+            values[0] = self.u.x.array.reshape(-1, d)[nodes.dofs[i], 0]
+            R = r.getArray().reshape(-1, d)[nodes.dofs[i]]
+            if d == 2:
+                values[1] = float(R @ nodes.tau[i]) / nodes.m[i]  # sigma_tau = -Phi_i = R.tau / m
+            else:  # 3-D: the size of the tangential stress vector
+                values[1] = float(np.linalg.norm(nodes.tau[i] @ R)) / nodes.m[i]
         values = self.comm.allreduce(values, op=MPI.SUM)
         out["probe_u1"], out["probe_sigma_tau"] = float(values[0]), float(values[1])
         return out

@@ -10,7 +10,7 @@ mu_f |S_n|), scheme (2.184)-(2.187) of Problem VP^{hk}:
 
 P1: V = {v = 0 on Gamma_D, v.nu = 0 on Gamma_C}; P2: V = {v = 0 on Gamma_D} and the load
 S_n (v.nu)_{Gamma_C}. sigma in Q^h (DG0 tensors). Step (2) by the friction solvers of
-friction.py (Newton on Phi_eps, eps_reg = 1e-9, by default); step (4) SNES vinewtonrsls.
+friction/ (Newton on Phi_eps, eps_reg = 1e-9, by default); step (4) SNES vinewtonrsls.
 Prefixes: ``damage_``, ``friction_`` (``uzawa_``, ``pd_``).
 """
 from __future__ import annotations
@@ -25,10 +25,10 @@ from mpi4py import MPI
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from .. import compat
-from ..boundary import clamped, normal_component_zero
+from ..boundary import bilateral_plane_faces, clamped
 from ..constitutive import eps, von_mises
 from ..forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
-from ..friction import FrictionProblem, iteration_counters, solver_from_parameters
+from ..friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from .base import ProblemData, TimeStepper
 
 FRICTION_LAWS = ("tresca", "coulomb")
@@ -69,7 +69,7 @@ class ElastoViscoplasticFriction(TimeStepper):
                                     ds(GAMMA_C))
         bcs = [clamped(V, tags, GAMMA_D)]
         if law == "tresca" or x["coulomb_normal"] == "bilateral":
-            bcs += normal_component_zero(V, tags, GAMMA_C)
+            bcs += bilateral_plane_faces(V, tags, GAMMA_C)
         g = fem.Constant(msh, float(x["g_fric"] if law == "tresca" else x["mu_f"] * abs(x["S_n"])))
         self.friction_problem = FrictionProblem(self.w, a, l, bcs, g, ds(GAMMA_C), self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
@@ -92,7 +92,7 @@ class ElastoViscoplasticFriction(TimeStepper):
     @staticmethod
     def _gamma_c_dofs(V, tags):
         facets = tags.indices[tags.values == GAMMA_C]
-        return fem.locate_dofs_topological(V, 1, facets)
+        return fem.locate_dofs_topological(V, V.mesh.topology.dim - 1, facets)
 
     # -- the scheme
     def _initial_state(self) -> dict:
@@ -126,7 +126,10 @@ class ElastoViscoplasticFriction(TimeStepper):
         out = super().scalars()
         out["zeta_min_x"], out["zeta_min_y"] = self._most_damaged_point()
         out["stress_Q"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
-        u1 = self.u.x.array.reshape(-1, 2)[self._contact_dofs, 0]  # Gamma_C is horizontal here
+        if self.mesh.topology.dim == 3:  # |u_tau| at the contact nodes (3-D, issue 17)
+            u1 = law.norm(self.friction.nodes.tangential(self.u))
+        else:
+            u1 = self.u.x.array.reshape(-1, 2)[self._contact_dofs, 0]  # Gamma_C is horizontal here
         out["slip_max"] = float(self.comm.allreduce(np.abs(u1).max() if u1.size else 0.0,
                                                     op=MPI.MAX))
         return out
