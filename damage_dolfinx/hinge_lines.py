@@ -13,11 +13,35 @@ the load-displacement curve.
 from __future__ import annotations
 
 import csv
+import math
 
 import numpy as np
 from mpi4py import MPI
 
 from . import figstyle
+
+
+def vault_summary(stepper) -> dict:
+    """The "vault" part of summary.json of a 3-D bridge run (problems/bridge_2_1.py): width,
+    the total load, and at collapse D per (section, layer), the unrolled faces and the section
+    rotations of the collapse step."""
+    geo, f = stepper.data.geometry, stepper.failure
+
+    def at_failure(key):
+        return None if f is None else f[key]
+    return {
+        "width_m": stepper.width, "n_width": geo.n_width, "ends": geo.ends,
+        "load": "P_kN is the line load per metre of width; total = P_kN x width_m",
+        "failure_load_total_kN": None if f is None else f["P_kN"] * stepper.width,
+        "nodes_per_section_layer": [int(stepper._layer_nodes.min()),
+                                    int(stepper._layer_nodes.max())],
+        "section_s_m": np.round(geo.section_points(np.arange(geo.n_theta + 1))["s"], 4).tolist(),
+        "s_load_m": round(0.5 * (geo.r_in + geo.r_out) * (geo.theta_left - math.acos(
+            (geo.x_load - geo.centre[0]) / geo.r_out)), 4),
+        "failure_zeta_extrados": at_failure("zeta_extrados"),
+        "failure_zeta_intrados": at_failure("zeta_intrados"),
+        "failure_section_damage_layers": at_failure("section_damage_layers"),
+        "failure_section_rotation_step_mrad": at_failure("section_rotation_step_mrad")}
 
 
 def face_maps(stepper):  # called by problems/bridge_2_1.py at collapse (3-D)
@@ -86,6 +110,23 @@ def plot_hinge_lines(summary, path, title=""):
     for spine in blank.spines.values():
         spine.set_visible(False)
     figstyle.save(fig, path, title=title)
+
+
+def draw_figure(stepper, fig, path):
+    """A catalogue figure of kind "problem" of the bridge stepper (collective; rank 0 draws):
+    fig.fields[0] is "hinge_lines" (3-D, at collapse) or "load_displacement" (P against the
+    downward displacement of the load patch, from history.csv next to ``path``)."""
+    if stepper.comm.rank != 0:
+        return
+    f = stepper.failure
+    if fig.fields[0] == "load_displacement":
+        plot_load_displacement(path.parent / "history.csv", None if f is None else f["P_kN"],
+                               path, fig.title)
+    elif fig.fields[0] == "hinge_lines" and f is not None and stepper._n_layers > 1:
+        summary = {**stepper.summary_extra(),
+                   "parameters": {"zeta_star": stepper.params.zeta_star}}
+        plot_hinge_lines(summary, path, title=f"{fig.title} (P = {f['P_kN']:.4g} kN/m, W = "
+                                              f"{stepper.width:g} m)")
 
 
 def read_curve(history_csv):

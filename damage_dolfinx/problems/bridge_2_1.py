@@ -384,26 +384,15 @@ class BridgeDamage(ElasticDamage):
 
     def summary_extra(self) -> dict:
         out = self._summary_2d()
-        f = self.failure
         if self._n_layers > 1:  # the 3-D vault: loads per metre of width, hinge lines
-            geo = self.data.geometry
-            out["vault"] = {
-                "width_m": self.width, "n_width": geo.n_width, "ends": geo.ends,
-                "load": "P_kN is the line load per metre of width; total = P_kN x width_m",
-                "failure_load_total_kN": None if f is None else f["P_kN"] * self.width,
-                "nodes_per_section_layer": [int(self._layer_nodes.min()),
-                                            int(self._layer_nodes.max())],
-                "section_s_m": np.round(geo.section_points(np.arange(geo.n_theta + 1))["s"],
-                                        4).tolist(),
-                "s_load_m": round(0.5 * (geo.r_in + geo.r_out) * (geo.theta_left - math.acos(
-                    (geo.x_load - geo.centre[0]) / geo.r_out)), 4),
-                "failure_zeta_extrados": None if f is None else f["zeta_extrados"],
-                "failure_zeta_intrados": None if f is None else f["zeta_intrados"],
-                "failure_section_damage_layers": None if f is None else
-                f["section_damage_layers"],
-                "failure_section_rotation_step_mrad": None if f is None else
-                f["section_rotation_step_mrad"]}
+            from ..hinge_lines import vault_summary
+            out["vault"] = vault_summary(self)
         return out
+
+    def draw_figure(self, fig, path):
+        """A catalogue figure of kind "problem" (hinge_lines.draw_figure)."""
+        from ..hinge_lines import draw_figure
+        draw_figure(self, fig, path)
 
     def _summary_2d(self) -> dict:
         geo = self.data.geometry
