@@ -13,6 +13,7 @@ from petsc4py import PETSc
 from . import compat
 from .constitutive import Psi_q, eta_star, split_norms_sq
 from .forms.damage import damage_step_forms
+from .obstacle import CHOLESKY_MAX_DOFS, ObstacleFastPath, fast_path_options
 from .solvers import ConvergenceError, LinearSolver, SNESSolver, SolveContext
 
 
@@ -37,6 +38,12 @@ def phi_B(e, z, p):
 def source(e, z, p):
     """The damage source phi(eps, zeta) of the variant selected in ``p`` (A or B)."""
     return phi_A(e, z, p) if p.variant == "A" else phi_B(e, z, p)
+
+
+def fast_path_counts(stepper) -> dict:
+    """The fast-path counts of a stepper's damage obstacle step (summary.json "iterations")."""
+    step = getattr(stepper, "damage", None)
+    return step.counts() if hasattr(step, "counts") else {}
 
 
 #: SNES defaults of the obstacle step (PROBLEMS.md 1.4); override with -damage_snes_* options.
@@ -75,6 +82,7 @@ class DamageStep:
             self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True,
                                        defaults=linear_defaults)
             return
+        enabled, solver = fast_path_options(prefix)  # a bad option is refused before any work
         self.a, self.L = compat.form(a), compat.form(L)
         self.A = compat.create_matrix(self.a)
         compat.assemble_matrix(self.A, self.a, [])
@@ -90,6 +98,10 @@ class DamageStep:
         self._f0 = None
         self.snes.snes.setConvergenceTest(self._converged)
         self.lu_retries = 0
+        # issue 18: the SNES's first iteration with cached linear algebra (obstacle.py);
+        # -<prefix>vi_fast 0 restores the SNES alone, bit for bit
+        self.fast = ObstacleFastPath(self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
+                                     CHOLESKY_MAX_DOFS[V.mesh.topology.dim]) if enabled else None
 
     def _converged(self, snes, it, norms):
         """PETSc's default tests plus a step test for the VI: when many nodes sit within
@@ -131,7 +143,13 @@ class DamageStep:
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
         # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
-        self.snes.snes.setTolerances(atol=max(self._atol, OBSTACLE_ATOL_REL * self.b.norm()))
+        atol = max(self._atol, OBSTACLE_ATOL_REL * self.b.norm())
+        self.snes.snes.setTolerances(atol=atol)
+        if self.fast is not None and self.fast.step(
+                compat.petsc_vec(self.zeta_old), self.b, compat.petsc_vec(self.zeta), atol,
+                self.snes.snes.getTolerances()[0]):
+            self.zeta.x.scatter_forward()
+            return 0  # no SNES iteration
         self.zeta.x.array[:] = self.zeta_old.x.array
         try:
             its = self.snes.solve(compat.petsc_vec(self.zeta))
@@ -152,6 +170,10 @@ class DamageStep:
         finally:
             ksp.setType(ksp_type)
             ksp.getPC().setType(pc_type)
+
+    def counts(self) -> dict:
+        """Fast-path hits, SNES fallbacks and reduced-solver set-ups (obstacle form only)."""
+        return self.fast.counts() if getattr(self, "fast", None) is not None else {}
 
     @property
     def iterations(self) -> int:

@@ -30,6 +30,7 @@ import numpy as np
 from mpi4py import MPI
 
 from . import checkpoint, examples, io, post
+from .damage import fast_path_counts
 from .parameters import InputError
 from .geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from .runfolder import RunLock, previous_run, remove_run_files
@@ -229,7 +230,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                            "step_time_s": f"{step_time:.4g}"})
         recorded["step"] = stepper.n
         summary.update(steps_done=stepper.n, t_final=stepper.t, final=scalars,
-                       iterations=stepper.iteration_totals(),
+                       iterations={**stepper.iteration_totals(), **fast_path_counts(stepper)},
                        wall_time_s=previous_wall + time.perf_counter() - wall_start,
                        **stepper.summary_extra())
         return scalars
