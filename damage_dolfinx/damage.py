@@ -95,6 +95,7 @@ class DamageStep:
                                self.b.duplicate(), self.A, OBSTACLE_DEFAULTS,
                                bounds=(self.lower, self.upper))
         self._atol = self.snes.snes.getTolerances()[1]
+        self.atol_rel = OBSTACLE_ATOL_REL  # a problem may lower it (3.3 wrench: 0, issue 18)
         self._f0 = None
         self.snes.snes.setConvergenceTest(self._converged)
         self.lu_retries = 0
@@ -143,7 +144,7 @@ class DamageStep:
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
         # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
-        atol = max(self._atol, OBSTACLE_ATOL_REL * self.b.norm())
+        atol = max(self._atol, self.atol_rel * self.b.norm())
         self.snes.snes.setTolerances(atol=atol)
         if self.fast is not None and self.fast.step(
                 compat.petsc_vec(self.zeta_old), self.b, compat.petsc_vec(self.zeta), atol,
