@@ -93,6 +93,15 @@ class FullyDamageableContact(TimeStepper):
         self.damage = None
         if self.damage_active:
             self.damage = self.obstacle_damage_step(damage_prefix)
+            # issue 18: ``damage_atol_rel`` (the wrench: 0) replaces the obstacle step's absolute
+            # tolerance 1e-9 ||l|| (damage.OBSTACLE_ATOL_REL) by snes_atol = 1e-12 alone; with
+            # 1e-9 ||l|| a step whose increment has a smaller residual keeps zeta_{n-1}, which
+            # dropped the wrench's damage up to t = 0.3 and in many steps up to t = 1.4
+            rel = x.get("damage_atol_rel")
+            if rel is not None:
+                if not float(rel) >= 0.0:
+                    raise InputError(f"damage_atol_rel must be >= 0, got {rel!r}")
+                self.damage.atol_rel = float(rel)
 
         # (3.159): velocity with the new damage in the viscosity
         tags = data.geometry.facet_tags
