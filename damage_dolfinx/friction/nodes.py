@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import numpy as np
 import ufl
 from dolfinx import fem
-from mpi4py import MPI
 from petsc4py import PETSc
 
 from .. import compat, scalable
@@ -113,11 +112,12 @@ class ContactNodes:
         normal = nm[self.dofs] / self.m[:, None]
         axis = np.argmax(np.abs(normal), axis=1)
         plane = np.abs(np.abs(normal[np.arange(self.dofs.size), axis]) - 1.0) <= 1e-10
-        if not msh.comm.allreduce(bool(np.all(plane)), op=MPI.LAND):
-            bad = normal[~plane][0] if not np.all(plane) else None
+        bad = [normal[~plane][0].round(3).tolist()] if not np.all(plane) else []
+        bad = sum(msh.comm.allgather(bad), [])
+        if bad:
             raise InputError("Tresca friction in 3-D is implemented on contact faces parallel "
-                             "to a coordinate plane only (a contact node has the averaged unit "
-                             f"normal {bad}: a tilted face or an edge between two faces)")
+                             "to a coordinate plane only (a contact node has the averaged normal "
+                             f"{bad[0]}: a tilted face or an edge between two faces)")
         self.axes = np.sort(np.column_stack([(axis + 1) % 3, (axis + 2) % 3]), axis=1)
         self.tau = np.zeros((self.dofs.size, 2, 3))
         for t in range(2):
