@@ -34,7 +34,7 @@ def test_block_on_normal_compliance_foundation_closed_form():
     semismooth Newton; checked at every node and by the 3-D contact monitor of 3.3."""
     from damage_dolfinx.boundary import bilateral_plane_faces
     from damage_dolfinx.forms.viscoelastic_memory import displacement_residual
-    from damage_dolfinx.problems.fully_damageable_3_3 import ContactMonitor
+    from damage_dolfinx.monitors import ContactMonitor
     from damage_dolfinx.solvers import NonlinearSolver, SolveContext
 
     E, nu, c_nu, p = 100.0, 0.3, 1e4, 10.0
@@ -74,7 +74,7 @@ def test_contact_monitor_normals_on_3d_facets():
     """The 3-D contact monitor: each Gamma_C triangle's normal is the outward unit normal of
     its face (bottom of the cube: (0, 0, -1)), so a downward rigid shift d is a penetration d
     at every vertex, an upward one none."""
-    from damage_dolfinx.problems.fully_damageable_3_3 import ContactMonitor
+    from damage_dolfinx.monitors import ContactMonitor
     geometry = _block(2)
     V = compat.vector_p1(geometry.mesh)
     monitor = ContactMonitor(V, geometry.facet_tags, GAMMA_C, 0.0)
