@@ -156,3 +156,49 @@ def test_contact_3d_serial_equals_two_ranks(tmp_path, example):
             continue
         scale = max(abs(value), 1e-12 if "penetration" in key else 1e-300)
         assert abs(p_sum["final"][key] - value) <= 1e-7 * scale, key
+
+
+@pytest.mark.parametrize("n", [3, 10])
+def test_dynamic_block_contact_force_balance(n):
+    """3.1 in 3-D: a free block (no Gamma_D) pushed by a pressure p onto the foundation. With
+    the constant test function w = e_z (in V: Gamma_D is empty) the velocity step (3.48) is the
+    discrete momentum balance rho (P_n - P_{n-1})/k = -p A_N + int_{Gamma_C} c_nu
+    (u_{n-1}.nu)_+ ds (viscous and elastic forces of a rigid w vanish; nu_z = -1 on the bottom),
+    P = int v_z dx: it must hold at every step to the solver tolerance, as must the zero x- and
+    y-momentum. n = 3: factorised velocity matrix; n = 10 (3993 unknowns): CG + GAMG."""
+    from damage_dolfinx.geometries.box import box, face
+    from damage_dolfinx.parameters import ModelParameters, TimeGrid
+    from damage_dolfinx.problems.base import ProblemData
+    from damage_dolfinx.problems.dynamic_3_1 import DynamicKelvinVoigt
+    p, rho, c_nu, k = 20.0, 1.0, 2e4, 0.01
+    geometry = box(MPI.COMM_WORLD, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (n, n, n),
+                   {GAMMA_C: face(2, 0.0), GAMMA_N: face(2, 1.0)})
+    params = ModelParameters(E=1000.0, nu=0.3, kappa=1.0, variant="A", lam_D=1e-2, lam_u=1e3,
+                             q_star=1.0, L_trunc=1000.0, stop_at_zeta_star=False,
+                             extra={"rho": rho, "m_visc": 10.0, "c_nu": c_nu, "gap": 0.0,
+                                    "damage_active": False, "stability_check": "off"})
+    data = ProblemData("block", geometry, params.validate(), TimeGrid(k, 0.3),
+                       traction=lambda x, t: ufl.as_vector((0.0, 0.0, -p)))
+    st = DynamicKelvinVoigt(data)
+    msh = st.mesh
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=geometry.facet_tags)
+    momentum = [compat.form(rho * st.v[i] * ufl.dx) for i in range(3)]
+    contact = compat.form(c_nu * ufl.max_value(ufl.dot(st.u, st.n_facet), 0.0) * ds(GAMMA_C))
+    area_N = compat.assemble_scalar(fem.Constant(msh, 1.0) * ds(GAMMA_N), msh.comm)
+    st.initialize()
+    worst, lateral, forces = 0.0, 0.0, []
+    for _ in range(st.num_steps):
+        P_old = compat.assemble_scalar(momentum[2], msh.comm)
+        F_c = compat.assemble_scalar(contact, msh.comm)  # at u_{n-1}
+        st.advance()
+        P = [compat.assemble_scalar(m, msh.comm) for m in momentum]
+        balance = -p * area_N + F_c
+        worst = max(worst, abs((P[2] - P_old) / k - balance) / (p * area_N))
+        lateral = max(lateral, abs(P[0]) + abs(P[1]))
+        forces.append(F_c)
+    if msh.comm.rank == 0:
+        print(f"n = {n}: momentum balance worst relative residual {worst:.2e}, lateral momentum "
+              f"{lateral:.2e}, contact force at the last steps {forces[-3:]} (p A = {p})")
+    assert max(forces) > 0.5 * p  # the foundation carries the block
+    assert worst < 1e-8
+    assert lateral < 1e-10 * p
