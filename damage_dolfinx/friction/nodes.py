@@ -156,16 +156,18 @@ class ContactNodes:
 
 def linear_defaults(V, symmetric=True) -> dict:
     """KSP defaults of the friction solves on V: direct (Cholesky; LU for a non-symmetric
-    matrix), except on 3-D meshes with at least scalable.DIRECT_MAX_DOFS_3D unknowns: CG
-    (GMRES if non-symmetric) + GAMG with the rigid-body near-nullspace (``near_nullspace``)."""
-    if scalable.iterative(V):
-        return {**scalable.MECH_AMG, **({} if symmetric else {"ksp_type": "gmres"})}
+    matrix) in 2-D and 3-D. Not the AMG of scalable.py: the stick blocks m g/eps (eps = 1e-9)
+    make the Jacobian ~1e9 times stiffer on the contact dofs than elsewhere, and CG + GAMG
+    (rtol 1e-10) did not give usable Newton directions: 2.2-ex1-3d at n = 16 (14 739 unknowns)
+    stopped at step 10 after 100 Newton iterations, where Cholesky converges (5 per step).
+    ``-friction_ksp_type cg -friction_pc_type gamg`` etc. still select it (with the rigid-body
+    modes of ``near_nullspace``)."""
     return spd_direct(V.mesh.comm) if symmetric else lu_direct(V.mesh.comm)
 
 
 def near_nullspace(V):
-    """The rigid-body modes of V where the friction solves are iterative (else None)."""
-    return scalable.rigid_body_modes(V) if scalable.iterative(V) else None
+    """The rigid-body modes of a 3-D V (for an AMG chosen by options), None in 2-D."""
+    return scalable.rigid_body_modes(V) if V.mesh.topology.dim == 3 else None
 
 
 def _assembled(L) -> np.ndarray:
