@@ -367,6 +367,9 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
             post.plot_damage_profiles(stepper.summary_extra()["profiles"], out / "history.csv",
                                       stepper.params.zeta_star, out / filename, fig.title)
         return {"file": filename}
+    if fig.kind == "problem":  # drawn by the stepper (collective): the vault's hinge lines
+        stepper.draw_figure(fig, out / filename)
+        return {"file": filename}
     if fig.kind == "slices":  # 3-D runs: fields on plane sections (issue 17, slices.py)
         from .slices import plot_slices
         planes = plot_slices([(stepper.von_mises, "von Mises stress [Pa]"),
