@@ -174,6 +174,10 @@ def vault_example(ex3):
         ],
         figures=[Figure("vault_slices.png", "2.1-ex3-vault at collapse: section z = W/2 (the "
                         "arch plane)", kind="slices"),
+                 Figure("hinge_lines.png", "2.1-ex3-vault at collapse: hinge lines",
+                        fields=("hinge_lines",), kind="problem"),
+                 Figure("load_displacement.png", "2.1-ex3-vault: load-displacement",
+                        fields=("load_displacement",), kind="problem"),
                  Figure("load_history.png", "2.1-ex3-vault: load and displacement under it",
                         fields=(("P_kN", "P [kN/m]"), ("u_load_y", "u_y under the load [m]"),
                                 ("weakest_section_zeta_max", "max zeta, weakest section")),
