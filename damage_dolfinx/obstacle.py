@@ -61,6 +61,11 @@ CHOLESKY_MAX_DOFS = {2: 300_000, 3: 30_000}
 #: systems; cholesky: factorise every system (one factorisation per new active set); cg: the
 #: SNES's CG for all (each accepted step then equals the SNES's bit for bit)
 SOLVERS = ("auto", "cholesky", "cg")
+#: after failed attempts on a nonempty active set in a row (3.3-ex2: values overshoot 1 every
+#: step, the SNES needs 3 iterations), such attempts pause 1, 2, 4, ... up to this many steps.
+#: Only attempts whose hit equals the SNES's answer bit for bit (its CG) pause, so the pause
+#: never changes a result (and a restart, which resets it, repeats the uninterrupted run).
+MAX_PAUSE = 16
 
 
 def fast_path_options(prefix: str):
@@ -95,13 +100,16 @@ class ObstacleFastPath:
         self.y, self.rhs = B.createVecRight(), B.createVecLeft()
         self._full = None  # solver of B (empty active set)
         self._key, self._cached = None, ()  # inactive mask and (KSP, rhs, y, B_II) of B_II
-        self.hits = self.fallbacks = self.setups = self.unchanged = 0
+        self.hits = self.fallbacks = self.setups = self.unchanged = self.skipped = 0
+        self._failures = self._pause = 0  # failed attempts with a nonempty active set in a row
 
     def counts(self) -> dict:
         """Accepted steps (of them ``unchanged``: z0 accepted at iteration 0, no solve), steps
-        handed to the SNES, and reduced solvers built (one per new active set)."""
+        handed to the SNES after an attempt (fallbacks) or without one (skipped), and solvers
+        built (B once, B_II once per new active set)."""
         return {"damage_vi_fast_hits": self.hits, "damage_vi_fast_unchanged": self.unchanged,
-                "damage_vi_fast_fallbacks": self.fallbacks, "damage_vi_fast_setups": self.setups}
+                "damage_vi_fast_fallbacks": self.fallbacks, "damage_vi_fast_skipped": self.skipped,
+                "damage_vi_fast_setups": self.setups}
 
     def _allsum(self, values) -> np.ndarray:
         values = np.asarray(values, dtype=float)
@@ -138,9 +146,27 @@ class ObstacleFastPath:
             self.hits += 1
             self.unchanged += 1
             return True
-        if not self._solve(inactive, f0):
-            self.fallbacks += 1
+        all_free = inactive is None or bool(inactive.all())
+        if self.comm.size > 1:
+            all_free = self.comm.allreduce(all_free, op=MPI.LAND)
+        if not all_free and not self.direct_reduced and self._pause > 0:
+            self._pause -= 1  # the SNES's own Newton step would be repeated: results unchanged
+            self.skipped += 1
             return False
+        if not self._solve(inactive, f0, all_free) or not self._accept(x0, l, z, inactive, atol,
+                                                                        rtol, fnorm0):
+            self.fallbacks += 1
+            if not all_free:  # wait 1, 2, 4, ... 16 steps before the next such attempt
+                self._failures += 1
+                self._pause = min(2 ** (self._failures - 1), MAX_PAUSE)
+            return False
+        self._failures = 0
+        self.hits += 1
+        return True
+
+    def _accept(self, x0, l, z, inactive, atol, rtol, fnorm0) -> bool:
+        """Step 2's update and projection, step 3's test; z = z1 if it passes."""
+        B, F = self.B, self.F
         x1, y = self.x1.array, self.y.array
         if inactive is None:  # x1 = x0 - y, the SNES's update (line search "basic")
             np.subtract(x0, y, out=x1)
@@ -160,17 +186,12 @@ class ObstacleFastPath:
                                           float(violation > FEASIBILITY_TOL)])
         fnorm1 = float(np.sqrt(fn1_sq))
         if violating or not (fnorm1 <= atol or fnorm1 <= rtol * fnorm0):
-            self.fallbacks += 1
             return False
         z.array[:] = x1
-        self.hits += 1
         return True
 
-    def _solve(self, inactive, f0) -> bool:
+    def _solve(self, inactive, f0, all_free) -> bool:
         """The Newton direction: B_II y_I = F0_I into self.y (entries outside I are left)."""
-        all_free = inactive is None or bool(inactive.all())
-        if self.comm.size > 1:
-            all_free = self.comm.allreduce(all_free, op=MPI.LAND)
         if all_free:  # empty active set: B itself, its solver built once per run
             if self._full is None:
                 self._full = self._ksp(self.B, self.direct_full)
