@@ -103,6 +103,21 @@ class DamageStep:
         # -<prefix>vi_fast 0 restores the SNES alone, bit for bit
         self.fast = ObstacleFastPath(self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
                                      CHOLESKY_MAX_DOFS[V.mesh.topology.dim]) if enabled else None
+        self.k, self._cellwise = k, None
+
+    def use_cellwise_source(self, u_old, p) -> bool:
+        """Assemble l by sparse maps when phi_old = source(eps(u_old), zeta_old, p) is constant on
+        every cell (variant A, lam_D = 0, P1 u; cellwise_source.py), if it gives the assembled l
+        to round-off; not with -<prefix>vi_fast 0 (today's path). Returns whether it is used."""
+        from .cellwise_source import CHECK_RTOL, CellwiseSource
+        if self.fast is None or p.variant != "A" or p.lam_D != 0.0 or \
+                compat.element_degree(u_old.function_space) != 1:
+            return False
+        source = CellwiseSource(u_old, self.zeta_old, float(getattr(self.k, "value", self.k)), p)
+        self.cellwise_check = source.check(self.L, u_old)
+        if self.cellwise_check <= CHECK_RTOL:
+            self._cellwise = source
+        return self._cellwise is not None
 
     def _converged(self, snes, it, norms):
         """PETSc's default tests plus a step test for the VI: when many nodes sit within
@@ -138,10 +153,13 @@ class DamageStep:
         """Compute zeta_n; returns iterations (KSP for the PDE form, Newton for the VI)."""
         if not self.obstacle:
             return self.linear.solve(self.zeta)
-        with self.b.localForm() as bl:
-            bl.set(0.0)
-        compat.assemble_vector(self.b, self.L)
-        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        if self._cellwise is not None:  # l by sparse maps (cellwise_source.py)
+            self._cellwise.rhs(self.b)
+        else:
+            with self.b.localForm() as bl:
+                bl.set(0.0)
+            compat.assemble_vector(self.b, self.L)
+            self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
         # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
         atol = max(self._atol, self.atol_rel * self.b.norm())
