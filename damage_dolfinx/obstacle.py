@@ -100,6 +100,7 @@ class ObstacleFastPath:
         self.y, self.rhs = B.createVecRight(), B.createVecLeft()
         self._full = None  # solver of B (empty active set)
         self._key, self._cached = None, ()  # inactive mask and (KSP, rhs, y, B_II) of B_II
+        self._reduced_ksp = None
         self.hits = self.fallbacks = self.setups = self.unchanged = self.skipped = 0
         self._failures = self._pause = 0  # failed attempts with a nonempty active set in a row
 
@@ -213,14 +214,22 @@ class ObstacleFastPath:
         if self.comm.size > 1:
             same = self.comm.allreduce(bool(same), op=MPI.LAND)
         if not same:
-            for obj in self._cached:
+            for obj in self._cached[1:]:  # the KSP is kept
                 obj.destroy()
             rows = (self.rstart + np.flatnonzero(inactive)).astype(PETSc.IntType)
             index = PETSc.IS().createGeneral(rows, comm=self.B.getComm())
             Bii = self.B.createSubMatrix(index, index)
             index.destroy()
             y, rhs = Bii.createVecs()
-            self._cached = (self._ksp(Bii, self.direct_reduced), rhs, y, Bii)
+            ksp = self._reduced_ksp
+            if ksp is None:
+                ksp = self._reduced_ksp = self._ksp(Bii, self.direct_reduced)
+            else:  # the same KSP object (type and options kept), new operator
+                ksp.reset()
+                ksp.setOperators(Bii)
+                ksp.setUp()
+                self.setups += 1
+            self._cached = (ksp, rhs, y, Bii)
             self._key = inactive.copy()
         return self._cached[:3]
 
