@@ -169,8 +169,13 @@ def vault_example(ex3):
             "over the width too) as in 2.1-ex3; the rotation of a section is the least-squares "
             "slope d u_t/d r over its plane (the mean over the width); per hinge line the spread "
             "of D and of the rotation across the width is reported",
-            "solvers (scalable.py): elasticity CG + GAMG with the rigid-body modes, damage "
-            "obstacle step SNES vinewtonrsls with CG + Jacobi",
+            "solvers: elasticity CG on a lagged LU factorisation (the 2-D default; scalable.py's "
+            "CG + GAMG needed 100-140 iterations per step at nu = 0.49 and broke down near "
+            "collapse, problems/bridge_2_1.py), damage obstacle step SNES vinewtonrsls",
+            "discretisation: linear tetrahedra lock at nu = 0.49: a thin vault is 17 % too stiff "
+            "at h = 0.1 (7 % at 0.05), so the failure load at h = 0.1 is a coarse-mesh value "
+            "(benchmarks/README.md, '3-D: the barrel vault'; at h = 0.05 a 0.1 m wide vault "
+            "fails at the 2-D arch's 94.5 kN/m)",
         ],
         figures=[Figure("vault_slices.png", "2.1-ex3-vault at collapse: section z = W/2 (the "
                         "arch plane)", kind="slices"),
