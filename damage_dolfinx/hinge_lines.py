@@ -127,6 +127,13 @@ def draw_figure(stepper, fig, path):
                    "parameters": {"zeta_star": stepper.params.zeta_star}}
         plot_hinge_lines(summary, path, title=f"{fig.title} (P = {f['P_kN']:.4g} kN/m, W = "
                                               f"{stepper.width:g} m)")
+    else:  # no collapse (or 2-D): say so instead of leaving the listed file missing
+        pyplot = figstyle.plt()
+        fig_, ax = pyplot.subplots(figsize=(6.0, 1.6))
+        ax.axis("off")
+        ax.text(0.5, 0.5, f"no collapse up to t = {stepper.t:.4g} s (P = "
+                f"{stepper.load_kN():.4g} kN/m): no hinge lines", ha="center", va="center")
+        figstyle.save(fig_, path, title=fig.title)
 
 
 def read_curve(history_csv):

@@ -179,7 +179,7 @@ def vault_example(ex3):
         ],
         figures=[Figure("vault_slices.png", "2.1-ex3-vault at collapse: section z = W/2 (the "
                         "arch plane)", kind="slices"),
-                 Figure("hinge_lines.png", "2.1-ex3-vault at collapse: hinge lines",
+                 Figure("hinge_lines.png", "2.1-ex3-vault: hinge lines at collapse",
                         fields=("hinge_lines",), kind="problem"),
                  Figure("load_displacement.png", "2.1-ex3-vault: load-displacement",
                         fields=("load_displacement",), kind="problem"),
