@@ -165,6 +165,16 @@ def linear_defaults(V, symmetric=True) -> dict:
     return spd_direct(V.mesh.comm) if symmetric else lu_direct(V.mesh.comm)
 
 
+def newton_linear(V) -> dict:
+    """KSP defaults of the friction Newton: ``linear_defaults`` in 2-D; in 3-D CG on J
+    preconditioned by the Cholesky factorisation of an earlier J (newton.LAG_MAX_ITS_3D), to
+    rtol 1e-12 of the true residual."""
+    if V.mesh.topology.dim == 2:
+        return linear_defaults(V)
+    return {**linear_defaults(V), "ksp_type": "cg", "ksp_norm_type": "unpreconditioned",
+            "ksp_rtol": 1e-12, "ksp_atol": 1e-50, "ksp_max_it": 200}
+
+
 def near_nullspace(V):
     """The rigid-body modes of a 3-D V (for an AMG chosen by options), None in 2-D."""
     return scalable.rigid_body_modes(V) if V.mesh.topology.dim == 3 else None
