@@ -247,24 +247,34 @@ class BlockUpdateSolver:
     factorised by the KSP of ``prefix`` whenever K changes. Rows that carry a Dirichlet condition
     (``free`` False) keep A's identity row and column. ``solve(K, b, x)`` returns False when the
     solve fails (a singular J). KSP ``defaults``: Cholesky unless given (e.g. lu_direct for a
-    non-symmetric K, or CG + GAMG with the ``near_nullspace`` of scalable.py)."""
+    non-symmetric K, or CG + GAMG with the ``near_nullspace`` of scalable.py).
+
+    With ``lag_its`` the KSP is a Krylov method (GMRES unless the defaults say otherwise)
+    preconditioned by the factorisation of an earlier J (the matrix P), refreshed when a solve
+    needed more than ``lag_its`` iterations; a failed solve is repeated once with P = J."""
 
     def __init__(self, A: PETSc.Mat, rows: np.ndarray, free: np.ndarray, prefix: str,
-                 defaults=None, near_nullspace=None):
+                 defaults=None, near_nullspace=None, lag_its=None):
         self.A, self.prefix = A, prefix
         self.comm = A.getComm().tompi4py()
         start, _ = A.getOwnershipRange()
         self.global_rows = (start + np.asarray(rows, dtype=np.int64)).astype(PETSc.IntType)
         self.mask = (free[:, :, None] & free[:, None, :]).astype(float)
         self.J = A.duplicate(copy=True)
-        set_default_options(prefix, defaults or spd_direct(self.comm))
+        defaults = dict(defaults or spd_direct(self.comm))
+        if lag_its is not None:
+            defaults.update({"ksp_type": "gmres", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
+                             "ksp_max_it": 200, "ksp_norm_type": "unpreconditioned"})
+        set_default_options(prefix, defaults)
         if near_nullspace is not None:
             self.J.setNearNullSpace(near_nullspace)
+        self.lag_its = lag_its
+        self.P = self.J.duplicate(copy=True) if lag_its is not None else self.J
         self.ksp = PETSc.KSP().create(self.comm)
         self.ksp.setOptionsPrefix(prefix)
-        self.ksp.setOperators(self.J)
+        self.ksp.setOperators(self.J, self.P)
         self.ksp.setFromOptions()
-        self._K = None
+        self._K, self._stale, self._fresh = None, True, False
         self.factorizations = self.solves = 0
 
     def set_K(self, K: np.ndarray):
@@ -278,13 +288,28 @@ class BlockUpdateSolver:
             self.J.setValues(rows, rows, block, addv=PETSc.InsertMode.ADD_VALUES)
         self.J.assemble()
         self._K = K
-        self.factorizations += 1
+        self.factorizations += 1  # of J (with lag_its: assemblies; P re-factorised on _refresh)
 
     def solve(self, K, b, x) -> bool:
         self.set_K(K)
+        if self.P is not self.J and self._stale:
+            self._refresh()
         self.ksp.solve(b, x)
         self.solves += 1
+        if self.P is self.J:
+            return self.ksp.getConvergedReason() > 0
+        if self.ksp.getConvergedReason() < 0 and not self._fresh:  # stale P: once with P = J
+            self._refresh()
+            self.ksp.solve(b, x)
+        self._stale = self.ksp.getIterationNumber() > self.lag_its
+        self._fresh = False
         return self.ksp.getConvergedReason() > 0
+
+    def _refresh(self):
+        """P = J (re-factorised at the next solve)."""
+        self.J.copy(self.P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self.P.assemble()
+        self._fresh = True
 
 
 def lu_direct(comm) -> dict:

@@ -13,6 +13,11 @@ from . import law
 from .nodes import JACOBIAN_SHIFT, linear_defaults, near_nullspace
 from .residual import AlgebraicResidual
 
+#: 3-D: GMRES iterations above which the lagged LU factorisation of the active-set matrix is
+#: rebuilt (condensed.BlockUpdateSolver; the blocks change in every iteration)
+LAG_ITS_3D = 30
+
+
 class PrimalDualActiveSet:
     """Primal-dual active-set (semismooth) Newton for the same regularised problem (2.99)-(2.101)
     (Stadler, SIAM J. Optim. 15, 2004), with the nodal multipliers lambda_i = Phi_eps(v_tau,i)/g_i
@@ -49,7 +54,7 @@ class PrimalDualActiveSet:
             V = self.p.V
             self.solver = BlockUpdateSolver(residual.A, self.rows, self.free_rows, prefix,
                                             linear_defaults(V, symmetric=False),
-                                            near_nullspace(V))
+                                            near_nullspace(V), lag_its=LAG_ITS_3D)
             return
         self.usable = comm.allreduce(bool(np.all(np.abs(tau[:, 0] * tau[:, 1]) < 1e-12)),
                                      op=MPI.LAND)
