@@ -41,7 +41,8 @@ class PrimalDualActiveSet:
     s_new = s is lambda = n). Its symmetric part would keep Cholesky usable but makes the
     multiplier converge linearly (factor 1/2: 35 iterations on the sliding block of
     tests/test_tresca_3d.py against 8 with the exact block), so J = A + blocks is assembled and
-    factorised by LU (condensed.BlockUpdateSolver)."""
+    solved by GMRES preconditioned with the LU factorisation of an earlier J
+    (condensed.BlockUpdateSolver with lag_its)."""
 
     def __init__(self, residual: "AlgebraicResidual", prefix: str):
         self.residual, self.nodes, self.p = residual, residual.nodes, residual.p
