@@ -29,9 +29,10 @@ _COMMON = [
     "the four friction solvers as in 2-D (--set friction_solver=...)",
     "1.9/G37 in 3-D: von Mises sqrt(3/2 dev(sigma):dev(sigma)), cell-wise (DG0)",
     "figures: sections through the body (slices.py); XDMF of the fields for ParaView",
-    "solvers: friction Newton with the 2x2-block Jacobian assembled algebraically, Cholesky "
-    "(PETSc serial, MUMPS parallel; -friction_ options override, e.g. CG + GAMG); damage "
-    "obstacle step SNES vinewtonrsls as in 2-D",
+    "solvers: friction Newton with the 2x2-block Jacobian assembled algebraically, CG "
+    "preconditioned by the Cholesky factorisation of an earlier Jacobian (PETSc serial, MUMPS "
+    "parallel; -friction_ options override); the active-set attempt likewise with GMRES and LU; "
+    "damage obstacle step SNES vinewtonrsls as in 2-D",
 ]
 
 
