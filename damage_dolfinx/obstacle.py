@@ -61,8 +61,10 @@ CHOLESKY_MAX_DOFS = {2: 300_000, 3: 30_000}
 #: systems; cholesky: factorise every system (one factorisation per new active set); cg: the
 #: SNES's CG for all (each accepted step then equals the SNES's bit for bit)
 SOLVERS = ("auto", "cholesky", "cg")
-#: after failed attempts on a nonempty active set in a row (3.3-ex2: values overshoot 1 every
-#: step, the SNES needs 3 iterations), such attempts pause 1, 2, 4, ... up to this many steps.
+#: after failed attempts on a nonempty active set in a row (3.1-ex1 while its zeta* region grows:
+#: the SNES needs 2-3 iterations in most steps), such attempts pause 1, 2, 4, ... up to this
+#: many steps. Failed attempts on an empty set (3.3-ex2: values overshoot 1 every step) cost one
+#: pair of triangular solves and never pause.
 #: Only attempts whose hit equals the SNES's answer bit for bit (its CG) pause, so the pause
 #: never changes a result (and a restart, which resets it, repeats the uninterrupted run).
 MAX_PAUSE = 16
