@@ -99,6 +99,10 @@ EXTRA_RULES = {
     "memory_rate": (lambda v: v >= 0, "(decay rate of the exponential kernel) must be >= 0"),
     "memory_mode": (lambda v: v in ("auto", "running", "recursive", "sum"),
                     "must be one of auto, running, recursive, sum"),
+    "damage_atol_rel": (lambda v: v >= 0, "(the obstacle step's absolute tolerance relative to "
+                        "||l||, issue 18) must be >= 0"),
+    "history_every": (lambda v: v >= 1 and v == int(v),
+                      "(a history.csv row every that many steps) must be a whole number >= 1"),
     "stability_check": (lambda v: v in ("warn", "error", "off"),
                         "(explicit-term time-step check, PROBLEMS.md 1.8) must be warn, error or off"),
     "damage_active": (lambda v: isinstance(v, bool),
