@@ -28,6 +28,9 @@ from damage_dolfinx import cli
     (["converge", "2.1-ex2a"], "no nested structured meshes"),
     (["converge", "2.1-ex1", "--ref-n", "40", "--n", "15"], "not nested"),
     (["converge", "2.1-ex1", "--ref-k", "0.003", "--k", "0.01"], "must divide every coarse k"),
+    (["run", "2.1-ex1", "--history-every", "0"], "history_every must be a whole number >= 1"),
+    (["run", "3.3-ex3", "--set", "history_every=2.5"], "must be a whole number >= 1"),
+    (["run", "3.3-ex3", "--set", "damage_atol_rel=-1"], "damage_atol_rel"),
 ])
 def test_bad_input_is_refused(tmp_path, capsys, args, message):
     out = tmp_path / "out"
