@@ -111,10 +111,15 @@ def plot_slices(fields, path, title="", zeta_star=0.01, planes=None, msh=None):
             ax.set_xlabel(f"${a}$ [m]")
             ax.set_ylabel(f"${b}$ [m]")
             heading = f"{figstyle.mathtext(label)}, section ${AXES[axis]}$ = {value:.4g}"
-            extreme = (f"whole body: min {body_min[row]:.3g}" if damage
+            extreme = (f"whole body: min {_damage_value(body_min[row])}" if damage
                        else f"whole body: max {body_max[row]:.3g}")
             ax.set_title(heading + f"\n{extreme}" + (f"; {note}" if note else ""))
             ticks = figstyle.damage_ticks(vmin, vmax, zeta_star) if damage else None
             figstyle.colorbar(fig, ax, image, cbar_label, ticks=ticks)
     figstyle.save(fig, path, title=title)
     return planes
+
+
+def _damage_value(z) -> str:
+    """min zeta for a title: 3 digits, more when it is within 1e-3 of 1 (0.99986, not '1')."""
+    return f"{z:.3g}" if z < 0.999 or z >= 1.0 else f"{z:.6f}".rstrip("0")
