@@ -116,17 +116,19 @@ def _threed_scaling(doc):
     folder = REFERENCE / "threed_scaling"
     shown = False
     for stem, label in (("scaling", "quasistatic (2.1-ex1-3d)"),
-                        ("scaling_dynamic", "dynamic")):
+                        ("scaling_dynamic", "dynamic (3.1-ex1-3d)")):
         table, plot = folder / f"{stem}.md", folder / f"{stem}.png"
         if table.is_file():
             doc.para(f"**{label}**, `python benchmarks/threed_scaling.py`, from `{_shown(table)}`:")
             doc.markdown_table(table.read_text())
             shown = True
         if plot.is_file():
-            doc.image(plot, f"3-D scaling, {label}: time per step against dofs "
-                            f"(`{_shown(plot)}`).")
+            doc.image(plot, f"3-D scaling, {label}: time per step and set-up, iterations per "
+                            f"solve and peak memory per rank against dofs (`{_shown(plot)}`).")
     extrapolation = folder / "extrapolation.md"
     if extrapolation.is_file():
+        doc.para(f"**A 10^8-dof cluster run**, extrapolated from the fits, from "
+                 f"`{_shown(extrapolation)}`:")
         doc.markdown_table(extrapolation.read_text())
     if not shown:
         doc.para("No 3-D scaling record (`python benchmarks/threed_scaling.py`).")
