@@ -8,9 +8,12 @@ reference mesh (:func:`post.nested_transfer`, P1 or DG0) and its error is measur
               (default ||u_ref - u_hk||_V + ||zeta_ref - zeta_hk||_Y; each problem sets the
               norm its thesis table uses, e.g. ||sigma||_Q for 2.4, ||v||_H for 3.1),
 
-so no reference history is stored. Everything runs under MPI. Outputs: ``errors.csv``,
-``errors.md``, ``convergence.png`` (log-log error vs h + k with the fitted rate) and
-``summary.json``.
+so no reference history is stored. Everything runs under MPI: the reference and the large
+cells on all ranks, the cells with n <= SERIAL_CELL_MAX_N serially, shared out among the ranks
+(a small mesh steps faster on one rank); each owner sends its cell's nodal values to the
+reference ranks for the measurement, and the norm is one product with a Gram matrix.
+Outputs: ``errors.csv``, ``errors.md``, ``convergence.png`` (log-log error vs h + k with the
+fitted rate) and ``summary.json``.
 """
 from __future__ import annotations
 
