@@ -177,7 +177,7 @@ def plot(kind: str, rows, path: Path):
 
 def extrapolation(all_rows: dict, target=1e8) -> str:
     """What a 10^8-dof run would cost, from the measured fits (see the text it writes)."""
-    lines = ["| example | measured up to [dofs u] | exponent 1 rank | 2-rank efficiency | "
+    lines = ["| example | serial fit over [dofs u] | exponent 1 rank | 2-rank efficiency (at) | "
              "work per step at 10^8 [core-s] | kB per vertex | memory [GB] | ranks | "
              "memory/rank [GB] | time/step [s] | steps | core-h |", "|" + "---|" * 12]
     # time/step and core-h as a range: parallel efficiency 1 (the serial work, spread) to the
@@ -198,7 +198,9 @@ def extrapolation(all_rows: dict, target=1e8) -> str:
         step = work / (ranks * efficiency)
         example = KINDS[kind][0]
         steps = {"2.1-ex1-3d": 50, "3.1-ex1-3d": 100}.get(example, 100)
-        lines.append(f"| {example} | {top['dofs_u']:.3g} | {a1:.2f} | {efficiency:.2f} | "
+        fitted = [r["dofs_u"] for r in one if r["dofs_u"] >= FIT_FROM_DOFS]
+        lines.append(f"| {example} | {min(fitted):.2g}-{max(fitted):.3g} | {a1:.2f} | "
+                     f"{efficiency:.2f} ({top['dofs_u']:.2g}) | "
                      f"{work:.3g} | {kb:.1f} | {mem_gb:.0f} | {ranks} | "
                      f"{mem_gb / ranks + 0.2:.1f} | {work / ranks:.3g}-{step:.3g} | {steps} | "
                      f"{work * steps / 3600:.3g}-{work * steps / efficiency / 3600:.3g} |")
@@ -206,7 +208,7 @@ def extrapolation(all_rows: dict, target=1e8) -> str:
     text = "\n".join(lines) + "\n"
     return text + (
         "\nHow the line is drawn: work per step at 10^8 dofs = the serial fit c N^a evaluated at "
-        "N = 10^8 (core-seconds; 'measured up to' says how far the fit is carried); ranks: "
+        "N = 10^8 (core-seconds; the fit's range says how far it is carried); ranks: "
         "as many as keep the dofs per rank of the largest 2-rank run (weak scaling); time per "
         "step = work / (ranks x efficiency), efficiency from 1 (the serial work spread perfectly) "
         "down to the one measured from 1 to 2 ranks at the largest size (on this shared 2-core "
