@@ -126,14 +126,18 @@ def _build(head_radius, across_flats, handle_start, handle_end, handle_width, lo
     return [(2, t) for _, t in gmsh.model.getEntities(2)]  # OCC may renumber on rotation
 
 
-def _classify(curves, across_flats, handle_width, load_start, handle_end, rotation_deg):
-    """(hexagon curves, loaded curves): curve midpoints mapped back to the local frame."""
+def _classify(entities, across_flats, handle_width, load_start, handle_end, rotation_deg,
+              dim=1):
+    """(hexagon, loaded): the boundary curves (dim 1) or side faces (dim 2, the extruded plate)
+    whose parametric midpoint, mapped back to the local frame, lies on a hexagon flat or on the
+    loaded end of the handle. A curved face's midpoint is on the face; its centre of mass is not."""
     c, s = math.cos(math.radians(rotation_deg)), math.sin(math.radians(rotation_deg))
     w2, tol = handle_width / 2, 1e-6 * handle_end
     hexagon, loaded = [], []
-    for tag in curves:
-        lo, hi = gmsh.model.getParametrizationBounds(1, tag)
-        X, Y, _ = gmsh.model.getValue(1, tag, [0.5 * (lo[0] + hi[0])])
+    for tag in entities:
+        lo, hi = gmsh.model.getParametrizationBounds(dim, tag)
+        mid = [0.5 * (a + b) for a, b in zip(lo, hi)]
+        X, Y, _ = gmsh.model.getValue(dim, tag, mid)
         x, y = c * X + s * Y, -s * X + c * Y  # inverse rotation
         if math.hypot(x, y) <= across_flats / 2 + tol:  # flat midpoints lie at the apothem
             hexagon.append(tag)
@@ -145,14 +149,18 @@ def _classify(curves, across_flats, handle_width, load_start, handle_end, rotati
     return hexagon, loaded
 
 
-def _mesh_sizes(hexagon, h, h_contact, transition):
-    """Size h_contact on the hexagon, growing linearly to h at distance ``transition``."""
+def _mesh_sizes(hexagon, h, h_contact, transition, dim=1):
+    """Size h_contact on the hexagon (its curves, dim 1, or faces, dim 2), growing linearly to h
+    at distance ``transition``."""
     field = gmsh.model.mesh.field
     dist = field.add("Distance")
-    for curves, sampling in (("CurvesList", "Sampling"), ("EdgesList", "NNodesByEdge")):
-        try:  # option names of gmsh >= 4.9, then of gmsh 4.8
-            field.setNumbers(dist, curves, hexagon)
-            field.setNumber(dist, sampling, 100)
+    # option names of gmsh >= 4.9, then of gmsh 4.8; samples per curve / per face direction
+    names = {1: (("CurvesList", "Sampling"), ("EdgesList", "NNodesByEdge")),
+             2: (("SurfacesList", "Sampling"), ("FacesList", "NNodesByEdge"))}[dim]
+    for entities, sampling in names:
+        try:
+            field.setNumbers(dist, entities, hexagon)
+            field.setNumber(dist, sampling, {1: 100, 2: 30}[dim])
             break
         except Exception:
             continue

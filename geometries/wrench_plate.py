@@ -16,15 +16,13 @@ rank 0 (gmsh, tetrahedra) and distributed.
 """
 from __future__ import annotations
 
-import math
-
 import gmsh
 
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
 from . import GAMMA_C, GAMMA_N, Geometry, gmsh_session
-from .wrench import FREE, _build, _check
+from .wrench import FREE, _build, _check, _classify, _mesh_sizes
 
 __all__ = ["wrench_plate", "FREE"]
 
@@ -51,13 +49,16 @@ def wrench_plate(comm, h: float = 0.2, h_contact: float = 0.1, thickness: float 
             gmsh.model.occ.synchronize()
             volumes = gmsh.model.getEntities(3)
             faces = [t for _, t in gmsh.model.getBoundary(volumes, combined=True, oriented=False)]
-            hexagon, loaded = _classify(faces, across_flats, handle_width, load_start,
-                                        handle_end, rotation_deg, thickness)
+            tol = 1e-6 * handle_end
+            sides = [t for t in faces  # not the plate faces z = 0 and z = thickness
+                     if abs(gmsh.model.occ.getCenterOfMass(2, t)[2] - thickness / 2) <= tol]
+            hexagon, loaded = _classify(sides, across_flats, handle_width, load_start,
+                                        handle_end, rotation_deg, dim=2)
             gmsh.model.addPhysicalGroup(3, [t for _, t in volumes], 1)
             gmsh.model.addPhysicalGroup(2, hexagon, GAMMA_C)
             gmsh.model.addPhysicalGroup(2, loaded, GAMMA_N)
             gmsh.model.addPhysicalGroup(2, sorted(set(faces) - set(hexagon) - set(loaded)), FREE)
-            _mesh_sizes(hexagon, h, h_contact, transition)
+            _mesh_sizes(hexagon, h, h_contact, transition, dim=2)
             gmsh.model.mesh.generate(3)
         except Exception as exc:  # reported on every rank, not only where gmsh runs
             error = f"wrench plate geometry: {exc}"
@@ -74,50 +75,3 @@ def wrench_plate(comm, h: float = 0.2, h_contact: float = 0.1, thickness: float 
                                 f"[{handle_start},{handle_end}]x[-{handle_width / 2},"
                                 f"{handle_width / 2}], load on x in [{load_start},{handle_end}], "
                                 f"rotated {rotation_deg} deg; gmsh h={h}, h_contact={h_contact}")
-
-
-def _classify(faces, across_flats, handle_width, load_start, handle_end, rotation_deg,
-              thickness):
-    """(hexagon faces, loaded faces): side faces (centre of mass at mid-thickness) by the point
-    at the middle of their parameter range (on the face: a curved face's centre of mass is not)
-    mapped back to the local frame, as the 2-D wrench classifies its curves."""
-    c, s = math.cos(math.radians(rotation_deg)), math.sin(math.radians(rotation_deg))
-    w2, tol = handle_width / 2, 1e-6 * handle_end
-    hexagon, loaded = [], []
-    for tag in faces:
-        if abs(gmsh.model.occ.getCenterOfMass(2, tag)[2] - thickness / 2) > tol:
-            continue  # the plate faces z = 0 and z = thickness
-        lo, hi = gmsh.model.getParametrizationBounds(2, tag)
-        X, Y, _ = gmsh.model.getValue(2, tag, [0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1])])
-        x, y = c * X + s * Y, -s * X + c * Y  # inverse rotation
-        if math.hypot(x, y) <= across_flats / 2 + tol:  # flat midpoints lie at the apothem
-            hexagon.append(tag)
-        elif abs(y - w2) <= tol and load_start - tol <= x <= handle_end + tol:
-            loaded.append(tag)
-    if len(hexagon) != 6 or len(loaded) != 1:
-        raise RuntimeError(f"found {len(hexagon)} hexagon faces and {len(loaded)} loaded faces "
-                           "(expected 6 and 1)")
-    return hexagon, loaded
-
-
-def _mesh_sizes(hexagon, h, h_contact, transition):
-    """Size h_contact on the hexagon faces, growing linearly to h at distance ``transition``."""
-    field = gmsh.model.mesh.field
-    dist = field.add("Distance")
-    for faces, sampling in (("SurfacesList", "Sampling"), ("FacesList", "NNodesByEdge")):
-        try:  # option names of gmsh >= 4.9, then of gmsh 4.8
-            field.setNumbers(dist, faces, hexagon)
-            field.setNumber(dist, sampling, 30)
-            break
-        except Exception:
-            continue
-    thr = field.add("Threshold")
-    field.setNumber(thr, "InField", dist)
-    field.setNumber(thr, "SizeMin", min(h_contact, h))
-    field.setNumber(thr, "SizeMax", h)
-    field.setNumber(thr, "DistMin", 0.0)
-    field.setNumber(thr, "DistMax", transition)
-    field.setAsBackgroundMesh(thr)
-    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
