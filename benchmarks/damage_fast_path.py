@@ -18,7 +18,6 @@ benchmarks/reference_output/step_floor/damage_fast_path_n<N>[_<label>].json and 
 """
 import argparse
 import json
-import os
 import sys
 import time
 from pathlib import Path
@@ -27,6 +26,9 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx import checkpoint, examples
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from timing import profile_rows, write_record  # noqa: E402
 
 PROBLEMS = ["2.2-ex1", "2.4-ex1", "3.1-ex1", "3.1-ex2", "3.2-ex1", "3.3-ex1", "3.3-ex3"]
 
@@ -102,21 +104,8 @@ def profile(example) -> dict:
             "nodes_at_1": int(np.sum(zeta >= 1.0)), "max_relative_difference": diffs}
 
 
-rows = []
-for example in PROBLEMS:
-    if args.only and example not in args.only:
-        continue
-    row = profile(example)
-    rows.append(row)
-    print(json.dumps(row), flush=True)
-out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
+rows = profile_rows(PROBLEMS, args.only, profile)
 stem = f"damage_fast_path_n{args.n}" + (f"_{args.label}" if args.label else "")
-import damage_dolfinx  # noqa: E402 (which checkout ran)
-(out / f"{stem}.json").write_text(json.dumps(
-    {"command": " ".join(["benchmarks/damage_fast_path.py", *sys.argv[1:]]),
-     "load_average": [round(x, 2) for x in os.getloadavg()],
-     "code": str(Path(damage_dolfinx.__file__).parent), "rows": rows}, indent=1))
 lines = ["| example | zeta dofs | t at start | damage ms per step (mean; median), SNES alone -> fast path | "
          "hits (unchanged) / fallbacks / set-ups | SNES its | nodes at zeta* / at 1 | "
          "largest relative field difference |", "|---|---|---|---|---|---|---|---|"]
@@ -130,5 +119,5 @@ for r in rows:
                  f"{c['damage_vi_fast_setups']} | {its['snes']} -> {its['fast']} | "
                  f"{r['nodes_at_zeta_star']} / {r['nodes_at_1']} | "
                  f"{max(r['max_relative_difference'].values()):.1e} |")
-(out / f"{stem}.md").write_text("\n".join(lines) + "\n")
-print("\n".join(lines))
+write_record(args.out, stem, rows, lines,
+             command=" ".join(["benchmarks/damage_fast_path.py", *sys.argv[1:]]))

@@ -15,9 +15,7 @@ path's hits and SNES fallbacks (damage_dolfinx/obstacle.py). Serial. Writes
 benchmarks/reference_output/step_floor/step_floor_n<N>.json and .md (--out to change).
 """
 import argparse
-import json
 import sys
-import os
 import time
 from pathlib import Path
 
@@ -30,7 +28,7 @@ from damage_dolfinx import compat, examples
 from damage_dolfinx.constitutive import eps
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from timing import best  # noqa: E402
+from timing import best, profile_rows, write_record  # noqa: E402
 
 PROBLEMS = ["2.1-ex1", "2.2-ex1", "2.3-ex1", "2.4-ex1", "3.1-ex1", "3.2-ex1", "3.3-ex1",
             "3.3-ex3"]
@@ -126,20 +124,8 @@ def profile(example) -> dict:
             "step_over_cholesky_solve": step_us / floor["cholesky_solve_us"]}
 
 
-rows = []
-for example in PROBLEMS:
-    if args.only and example not in args.only:
-        continue
-    row = profile(example)
-    rows.append(row)
-    print(json.dumps(row), flush=True)
-out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
+rows = profile_rows(PROBLEMS, args.only, profile)
 stem = f"step_floor_n{args.n}" + (f"_{args.label}" if args.label else "")
-import damage_dolfinx  # noqa: E402 (which checkout ran)
-(out / f"{stem}.json").write_text(json.dumps(
-    {"load_average": [round(x, 2) for x in os.getloadavg()],
-     "code": str(Path(damage_dolfinx.__file__).parent), "rows": rows}, indent=1))
 lines = ["| example | dofs (u) | ms per step (wall / CPU) | split (ms) | SpMV / CG it / Cholesky "
          "solve (us) | step over SpMV / CG it / Cholesky solve | damage fast path: hits "
          "(unchanged) / SNES fallbacks |", "|---|---|---|---|---|---|---|"]
@@ -153,5 +139,4 @@ for r in rows:
                  f"{f['cg_iteration_us']:.0f} / {f['cholesky_solve_us']:.0f} | "
                  f"{r['step_over_spmv']:.0f} / {r['step_over_cg_iteration']:.0f} / "
                  f"{r['step_over_cholesky_solve']:.1f} | {fast} |")
-(out / f"{stem}.md").write_text("\n".join(lines) + "\n")
-print("\n".join(lines))
+write_record(args.out, stem, rows, lines)
