@@ -78,37 +78,17 @@ class ContactNodes:
     def __init__(self, problem: FrictionProblem):
         if problem.dim == 3:
             return self._init_3d(problem)
-        V, msh = problem.V, problem.msh
-        S = compat.scalar_p1(msh)
-        phi, w = ufl.TestFunction(S), ufl.TestFunction(V)
-        ds = problem.nodal_ds()
-        n_owned = S.dofmap.index_map.size_local
-        m = _assembled(phi * ds)[:n_owned]
-        gm = _assembled(problem.g * phi * ds)[:n_owned]
+        w, ds, n_owned = self._weights_and_bounds(problem)
         tm = _assembled(ufl.dot(problem.tangent(), w) * ds).reshape(-1, 2)[:n_owned]
-        self.dofs = np.flatnonzero(m > 0)
-        if not np.allclose(S.tabulate_dof_coordinates()[self.dofs],
-                           V.tabulate_dof_coordinates()[self.dofs]):
-            raise RuntimeError("scalar and vector P1 dof numberings differ")  # never seen
-        self.m = m[self.dofs]
-        self.g = gm[self.dofs] / self.m
         tau = tm[self.dofs] / self.m[:, None]
         self.tau = tau / np.linalg.norm(tau, axis=1)[:, None]
 
     def _init_3d(self, problem: FrictionProblem):
         """Weights and bounds as in 2-D; the averaged unit normal of each node must be a
         coordinate axis (a face parallel to a coordinate plane, not an edge between two faces)."""
-        V, msh = problem.V, problem.msh
-        S = compat.scalar_p1(msh)
-        phi, w = ufl.TestFunction(S), ufl.TestFunction(V)
-        ds = problem.nodal_ds()
-        n_owned = S.dofmap.index_map.size_local
-        m = _assembled(phi * ds)[:n_owned]
-        gm = _assembled(problem.g * phi * ds)[:n_owned]
+        msh = problem.msh
+        w, ds, n_owned = self._weights_and_bounds(problem)
         nm = _assembled(ufl.dot(ufl.FacetNormal(msh), w) * ds).reshape(-1, 3)[:n_owned]
-        self.dofs = np.flatnonzero(m > 0)
-        self.m = m[self.dofs]
-        self.g = gm[self.dofs] / self.m
         normal = nm[self.dofs] / self.m[:, None]
         axis = np.argmax(np.abs(normal), axis=1)
         plane = np.abs(np.abs(normal[np.arange(self.dofs.size), axis]) - 1.0) <= 1e-10
@@ -122,6 +102,24 @@ class ContactNodes:
         self.tau = np.zeros((self.dofs.size, 2, 3))
         for t in range(2):
             self.tau[np.arange(self.dofs.size), t, self.axes[:, t]] = 1.0
+
+    def _weights_and_bounds(self, problem: FrictionProblem):
+        """The owned contact nodes (dofs), their lumped weights m_i and bounds g_i; returns the
+        vector test function, the nodal-quadrature measure and the number of owned nodes."""
+        V, msh = problem.V, problem.msh
+        S = compat.scalar_p1(msh)
+        phi, w = ufl.TestFunction(S), ufl.TestFunction(V)
+        ds = problem.nodal_ds()
+        n_owned = S.dofmap.index_map.size_local
+        m = _assembled(phi * ds)[:n_owned]
+        gm = _assembled(problem.g * phi * ds)[:n_owned]
+        self.dofs = np.flatnonzero(m > 0)
+        if not np.allclose(S.tabulate_dof_coordinates()[self.dofs],
+                           V.tabulate_dof_coordinates()[self.dofs]):
+            raise RuntimeError("scalar and vector P1 dof numberings differ")  # never seen
+        self.m = m[self.dofs]
+        self.g = gm[self.dofs] / self.m
+        return w, ds, n_owned
 
     @property
     def dim(self) -> int:
