@@ -65,12 +65,7 @@ def wrench(comm, h: float = 0.15, h_contact: float = 0.05, head_radius: float = 
         except Exception as exc:  # reported on every rank, not only where gmsh runs
             error = f"wrench geometry: {exc}"
             gmsh.model.remove()
-    error = comm.bcast(error, root=0)
-    if error is not None:
-        raise InputError(error)
-    msh, _, facet_tags = compat.model_to_mesh(gmsh.model, comm, 0, gdim=2)
-    if comm.rank == 0:
-        gmsh.model.remove()
+    msh, facet_tags = _to_mesh(comm, error, gdim=2)
     return Geometry(msh, facet_tags, h=h,
                     description=f"ring wrench (G35): head R={head_radius}, hexagon across flats "
                                 f"{across_flats}, handle [{handle_start},{handle_end}]x"
@@ -124,6 +119,18 @@ def _build(head_radius, across_flats, handle_start, handle_end, handle_width, lo
     occ.rotate(surfaces, 0, 0, 0, 0, 0, 1, math.radians(rotation_deg))
     occ.synchronize()
     return [(2, t) for _, t in gmsh.model.getEntities(2)]  # OCC may renumber on rotation
+
+
+def _to_mesh(comm, error, gdim):
+    """The gmsh model built on rank 0 as a distributed mesh, or its error as one InputError line
+    on every rank (the wrench and the wrench plate)."""
+    error = comm.bcast(error, root=0)
+    if error is not None:
+        raise InputError(error)
+    msh, _, facet_tags = compat.model_to_mesh(gmsh.model, comm, 0, gdim=gdim)
+    if comm.rank == 0:
+        gmsh.model.remove()
+    return msh, facet_tags
 
 
 def _classify(entities, across_flats, handle_width, load_start, handle_end, rotation_deg,

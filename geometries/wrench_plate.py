@@ -18,11 +18,10 @@ from __future__ import annotations
 
 import gmsh
 
-from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
 from . import GAMMA_C, GAMMA_N, Geometry, gmsh_session
-from .wrench import FREE, _build, _check, _classify, _mesh_sizes
+from .wrench import FREE, _build, _check, _classify, _mesh_sizes, _to_mesh
 
 __all__ = ["wrench_plate", "FREE"]
 
@@ -63,12 +62,7 @@ def wrench_plate(comm, h: float = 0.2, h_contact: float = 0.1, thickness: float 
         except Exception as exc:  # reported on every rank, not only where gmsh runs
             error = f"wrench plate geometry: {exc}"
             gmsh.model.remove()
-    error = comm.bcast(error, root=0)
-    if error is not None:
-        raise InputError(error)
-    msh, _, facet_tags = compat.model_to_mesh(gmsh.model, comm, 0, gdim=3)
-    if comm.rank == 0:
-        gmsh.model.remove()
+    msh, facet_tags = _to_mesh(comm, error, gdim=3)
     return Geometry(msh, facet_tags, h=h,
                     description=f"ring wrench plate (G35 outline extruded by {thickness}): head "
                                 f"R={head_radius}, hexagon across flats {across_flats}, handle "
