@@ -65,6 +65,10 @@ def _parser():
     conv.add_argument("--ref-k", type=float, help="reference time step")
     conv.add_argument("--n", type=int, nargs="+", help="coarse meshes")
     conv.add_argument("--k", type=float, nargs="+", help="coarse time steps")
+    conv.add_argument("--reference-ranks", choices=("1", "all"),
+                      help="the reference on rank 0 alone, every cell serially on the other "
+                           "ranks (1), or the reference and the cells n > 64 on all ranks "
+                           "(all); default: the example's choice (convergence.py)")
     return p
 
 
@@ -155,7 +159,9 @@ def main(argv=None):
                               ns=args.n, ks=args.k, T=args.T,
                               overrides=_overrides(args.set, args.friction_solver,
                                                    args.friction_law, args.reading),
-                              progress=not args.quiet)
+                              progress=not args.quiet,
+                              reference_ranks={"1": 1, "all": "all", None: None}[
+                                  args.reference_ranks])
             return 0
     except InputError as exc:
         if comm.rank == 0:

@@ -45,12 +45,20 @@ class _CoarseRun:
     def mine(self) -> bool:
         return self.stepper is not None
 
-    def connect(self, ref, grid, h, transfers, norms, comm):
-        """Set up the measurement against ``ref`` (collective on ``comm``, the reference's)."""
+    def connect(self, ref, grid, h, transfers, norms, comm, ref_rank=None, world=None,
+                outbox=None):
+        """Set up the measurement against ``ref`` (collective on ``comm``, the reference's).
+        ``ref_rank``: the reference runs on that rank of ``world`` alone (``ref`` is None on
+        the others, which only send their cells' values, without waiting: ``outbox`` holds
+        the sends in flight, shared by the cells of a rank)."""
         self.h, self.comm, self.norms = h, comm, norms
+        self.ref_rank, self.world, self._grid, self._send = ref_rank, world, grid, {}
+        self.outbox = outbox
+        self.components = []
+        if ref is None:
+            return
         coarse = dict((name, f) for name, f, _ in self.stepper.error_components) \
             if self.mine else {}
-        self.components = []
         for name, f_ref, _ in ref.error_components:
             fine_side = transfers(grid, f_ref.function_space)
             f = coarse.get(name)
@@ -66,15 +74,34 @@ class _CoarseRun:
         self.wall += time.perf_counter() - start
 
     def measure(self):
-        """Error at the current common time level; collective on the reference's ranks."""
+        """Error at the current common time level; collective on the reference's ranks (with
+        a reference on rank 0 alone, the owner sends its grid values there, point to point)."""
+        if self.ref_rank is not None and self.world.rank != self.ref_rank:
+            if self.mine:  # send each component (the reference's order: same example)
+                for name, f, _ in self.stepper.error_components:
+                    if name not in self._send:
+                        self._send[name] = post.nested_transfer(f.function_space, None,
+                                                                self._grid)
+                    values = np.ascontiguousarray(self._send[name].grid_values(f))
+                    self.outbox.append((self.world.Isend(values, dest=self.ref_rank, tag=7),
+                                        values))
+                if len(self.outbox) > MAX_SENDS_IN_FLIGHT:  # bound the memory of a fast rank
+                    half = len(self.outbox) // 2
+                    MPI.Request.Waitall([req for req, _ in self.outbox[:half]])
+                    del self.outbox[:half]
+            return
         total = 0.0
         for name, fine_side, coarse_side, f, f_fine in self.components:
-            if self.owner is None:
+            if self.owner is None or self.mine:
                 on_grid = coarse_side.grid_values(f)
+                if self.owner is not None and self.ref_rank is None and self.comm.size > 1:
+                    self.comm.Bcast(on_grid, root=self.owner)
             else:
-                on_grid = coarse_side.grid_values(f) if self.mine else \
-                    np.empty(fine_side.grid_shape)
-                self.comm.Bcast(on_grid, root=self.owner)
+                on_grid = np.empty(fine_side.grid_shape)
+                if self.ref_rank is None:
+                    self.comm.Bcast(on_grid, root=self.owner)
+                else:
+                    self.world.Recv(on_grid, source=self.owner, tag=7)
             fine_side.to_fine(on_grid, f_fine)
             e = self.norms[name](f_fine)
             self.err_parts[name] = max(self.err_parts[name], e)
@@ -83,25 +110,31 @@ class _CoarseRun:
         self.err_T = total  # the last measurement is at t = T
 
 
+#: sends of cell values a rank may have in flight to the reference's rank (then it waits for
+#: the older half): the cells' ranks run ahead of the reference by up to this many messages
+MAX_SENDS_IN_FLIGHT = 400
+
 #: coarse cells with at most this many mesh cells per side run serially, shared out among
 #: the ranks (a 2-rank step of a small mesh is slower than a serial one); larger cells, like
 #: the reference, run on all ranks
 SERIAL_CELL_MAX_N = 64
 
 
-def _owners(ns, ks, T, size, serial_max_n=SERIAL_CELL_MAX_N) -> dict:
+def _owners(ns, ks, T, size, serial_max_n=SERIAL_CELL_MAX_N, exclude=None) -> dict:
     """(n, k) -> rank that runs the cell serially, or None (all ranks). The serial cells of each
     k (they step at the same time levels) are shared out greedily by cost, steps x vertices,
     to the rank with the least work in that k, then in total: the ranks wait for each other at
-    every reference step, so the balance must hold per time level, not only on the sum."""
+    every reference step, so the balance must hold per time level, not only on the sum.
+    ``exclude``: a rank that gets no cell (the one running the reference alone)."""
     owners, total = {}, np.zeros(size)
+    ranks = [r for r in range(size) if r != exclude] or list(range(size))
     for k in ks:
         in_k = np.zeros(size)
         for n in sorted(ns, reverse=True):
             if size == 1 or n > serial_max_n:
                 owners[(n, k)] = None
                 continue
-            rank = min(range(size), key=lambda r: (in_k[r], total[r]))
+            rank = min(ranks, key=lambda r: (in_k[r], total[r]))
             cost = (T / k) * (n + 1) ** 2
             in_k[rank] += cost
             total[rank] += cost
@@ -142,8 +175,18 @@ def _check_nested(ref_n, ref_k, ns, ks):
 
 
 def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, overrides=None,
-          progress=True, comm=MPI.COMM_WORLD, serial_max_n=SERIAL_CELL_MAX_N) -> dict:
-    """Run the study; returns the summary (errors per (n, k), fitted rates, wall times)."""
+          progress=True, comm=MPI.COMM_WORLD, serial_max_n=SERIAL_CELL_MAX_N,
+          reference_ranks=None) -> dict:
+    """Run the study; returns the summary (errors per (n, k), fitted rates, wall times).
+
+    ``reference_ranks`` (default: the catalogue's ``convergence["reference_ranks"]``, else 1):
+    1 runs the reference serially on rank 0 and every coarse cell serially on the other ranks
+    (the measurements on rank 0); "all" runs the reference and the cells n > SERIAL_CELL_MAX_N
+    on all ranks, the smaller cells serially shared out among all ranks. On 2 cores the first
+    is faster for every thesis study (issue 18, benchmarks/README.md): a serial step uses
+    PETSc's Cholesky and the serial-only zeta-linear matrices of 3.3, MUMPS on 2 ranks is no
+    faster than that, and the second rank is free for the cells. A finer reference on many
+    ranks wants "all"."""
     wall_start = time.perf_counter()
     ex = examples.get(example_id, (overrides or {}).get("reading"))
     defaults = ex.convergence
@@ -161,9 +204,13 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
         TimeGrid(k, T)
     out = io.prepare_output_dir(out, comm)
 
-    ref = ex.build(comm, n=ref_n, k=ref_k, T=T, overrides=overrides)
-    norms = _component_norms(ref)
-    owners = _owners(ns, ks, T, comm.size, serial_max_n)
+    ref_serial = comm.size > 1 and (reference_ranks or defaults.get("reference_ranks", 1)) == 1
+    ref_rank, ref_comm = (0, MPI.COMM_SELF) if ref_serial else (None, comm)
+    ref = ex.build(ref_comm, n=ref_n, k=ref_k, T=T, overrides=overrides) \
+        if not ref_serial or comm.rank == ref_rank else None
+    norms = _component_norms(ref) if ref is not None else {}
+    owners = _owners(ns, ks, T, comm.size, max(ns) if ref_serial else serial_max_n,
+                     exclude=ref_rank)
     runs = []
     for n in ns:
         for k in ks:
@@ -183,41 +230,58 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
             fine_sides[key] = post.nested_transfer(None, V_fine, grid)
         return fine_sides[key]
 
+    outbox = []
     for run in runs:
-        run.connect(ref, *geometry[(run.n, run.k)], transfers, norms, comm)
-    report = Progress(f"{ex.id} converge", ref.num_steps, comm, enabled=progress, interval=10.0)
+        run.connect(ref, *geometry[(run.n, run.k)], transfers, norms, ref_comm, ref_rank, comm,
+                    outbox)
+    num_steps = comm.bcast(ref.num_steps if comm.rank == 0 else None, root=0)
+    report = Progress(f"{ex.id} converge", num_steps, comm, enabled=progress, interval=10.0)
 
     ref_wall = time.perf_counter()
-    stats = ref.initialize()
+    stats = ref.initialize() if ref is not None else {}
     ref_wall = time.perf_counter() - ref_wall
     for run in runs:
         if run.mine:
             run.advance(initial=True)
     for run in runs:
         run.measure()
-    while ref.n < ref.num_steps:
+    step, measure_wall = 0, 0.0
+    while step < num_steps:
         start = time.perf_counter()
-        stats = ref.advance()
+        if ref is not None:
+            stats = ref.advance()
         ref_wall += time.perf_counter() - start
-        due = [run for run in runs if ref.n % run.ratio == 0]
+        step += 1
+        due = [run for run in runs if step % run.ratio == 0]
         for run in due:  # serial cells first: no rank waits for the other inside a parallel one
             if run.mine and run.owner is not None:
                 run.advance()
         for run in due:
             if run.owner is None:
                 run.advance()
+        start = time.perf_counter()
         for run in due:
             run.measure()
-        report(ref.n, ref.t, stats, ref.scalars() if progress else None)
+        measure_wall += time.perf_counter() - start
+        if ref is not None:
+            report(step, ref.t, stats, ref.scalars)
+    MPI.Request.Waitall([req for req, _ in outbox])
     cell_wall = comm.allreduce(np.array([r.wall if r.mine and (r.owner is not None or
                                                                comm.rank == 0) else 0.0
                                          for r in runs]), op=MPI.SUM)
     for run, wall in zip(runs, cell_wall):
         run.wall = float(wall)
 
-    definition = _error_definition(ref.error_components)
+    components = comm.bcast([(name, None, norm) for name, _, norm in ref.error_components]
+                            if comm.rank == 0 else None, root=0)
+    if ref_serial:  # the errors were measured on rank 0
+        errors = comm.bcast([(r.err, r.err_T, r.err_parts) for r in runs]
+                            if comm.rank == 0 else None, root=0)
+        for r, (err, err_T, parts) in zip(runs, errors):
+            r.err, r.err_T, r.err_parts = err, err_T, parts
+    definition = _error_definition(components)
     rows = [{"n": r.n, "h": r.h, "k": r.k, "h_plus_k": r.h + r.k, "error": r.err,
-             **{f"error_{name}_{norm}": r.err_parts[name] for name, _, norm in ref.error_components},
+             **{f"error_{name}_{norm}": r.err_parts[name] for name, _, norm in components},
              "error_at_T": r.err_T, "wall_time_s": r.wall} for r in runs]
     rates = fitted_rates(rows, ns, ks)
     rates_T = fitted_rates(rows, ns, ks, key="error_at_T")
@@ -225,11 +289,15 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
                "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
                "error_definition": definition,
                "errors": rows, "rates": rates, "rates_at_T": rates_T, "mpi_size": comm.size,
-               "serial_cells": {"max_n": serial_max_n if comm.size > 1 else None,
+               "serial_cells": {"max_n": (max(ns) if ref_serial else serial_max_n)
+                                if comm.size > 1 else None,
                                 "rank_of_cell": [[r.n, r.k, r.owner] for r in runs]},
-               "reference": {"wall_time_s": ref_wall, "mesh": ref.mesh_info(),
-                             "final": ref.scalars(), "iterations": ref.iteration_totals()},
-               "parameters": ref.params.as_dict(), "assumptions": ex.assumptions,
+               "reference": {"wall_time_s": ref_wall, "ranks": 1 if ref_serial else comm.size,
+                             "measurements_wall_time_s": measure_wall,
+                             **({"mesh": ref.mesh_info(), "final": ref.scalars(),
+                                 "iterations": ref.iteration_totals()} if ref is not None else {})},
+               "parameters": ref.params.as_dict() if ref is not None else None,
+               "assumptions": ex.assumptions,
                "wall_time_s": time.perf_counter() - wall_start,
                "environment": io.environment(comm)}
     if comm.rank == 0:

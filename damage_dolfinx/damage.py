@@ -14,7 +14,7 @@ from . import compat
 from .constitutive import Psi_q, eta_star, split_norms_sq
 from .forms.damage import damage_step_forms
 from .obstacle import CHOLESKY_MAX_DOFS, ObstacleFastPath, fast_path_options
-from .solvers import ConvergenceError, LinearSolver, SNESSolver, SolveContext
+from .solvers import ConvergenceError, LinearSolver, SNESSolver, SolveContext, spd_direct
 
 
 def phi_A(e, z, p):
@@ -78,9 +78,13 @@ class DamageStep:
                                  k, kappa)
         self.zeta, self.zeta_old, self.obstacle = zeta, zeta_old, obstacle
         if not obstacle:
-            # linear_defaults: KSP options of the PDE form (None: direct; 3-D: scalable.py)
+            # linear_defaults: KSP options of the PDE form (None: direct; the matrix
+            # M + k kappa K is SPD: PETSc's Cholesky serially (spd_direct, issue 18), MUMPS LU
+            # in parallel; 3-D: scalable.py)
+            serial = V.mesh.comm.size == 1
             self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True,
-                                       defaults=linear_defaults)
+                                       defaults=linear_defaults or
+                                       (spd_direct(V.mesh.comm) if serial else None))
             return
         enabled, solver = fast_path_options(prefix)  # a bad option is refused before any work
         self.a, self.L = compat.form(a), compat.form(L)

@@ -99,12 +99,14 @@ class Example:
             return self.with_reading(name), overrides
         return self, overrides
 
-    def configure(self, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None):
+    def configure(self, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+                  comm=None):
         """Validated (params, time grid, n, h, mesh_file) for a run; raises InputError.
-        ``overrides`` may name the reading (key ``reading``)."""
+        ``overrides`` may name the reading (key ``reading``). ``comm``: the ranks of the run
+        (default all), which the memory check is collective on."""
         ex, overrides = self._resolved(overrides)
         if ex is not self:
-            return ex.configure(n, k, T, h, overrides, mesh_file)
+            return ex.configure(n, k, T, h, overrides, mesh_file, comm)
         params = self.params.replace(**(overrides or {})).validate()
         time = TimeGrid(self.k if k is None else float(k), self.T if T is None else float(T))
         if n is not None and self.n is None:
@@ -122,7 +124,9 @@ class Example:
         if mesh_file is None:
             from mpi4py import MPI
             from .resources import check_memory
-            check_memory(self, n, h, MPI.COMM_WORLD)  # a mesh that cannot fit is refused now
+            # a mesh that cannot fit is refused now (collective on the run's ranks: a serial
+            # cell of a convergence study is built on one rank alone)
+            check_memory(self, n, h, comm or MPI.COMM_WORLD)
         return params, time, n, h, mesh_file
 
     def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None):
@@ -130,7 +134,7 @@ class Example:
         ex, overrides = self._resolved(overrides)
         if ex is not self:
             return ex.build(comm, n, k, T, h, overrides, mesh_file)
-        params, time, n, h, mesh_file = self.configure(n, k, T, h, overrides, mesh_file)
+        params, time, n, h, mesh_file = self.configure(n, k, T, h, overrides, mesh_file, comm)
         if mesh_file is not None:
             from .geometries import read_msh
             geometry = read_msh(comm, mesh_file)

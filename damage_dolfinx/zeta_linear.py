@@ -34,7 +34,8 @@ class ZetaLinearMatrix:
         self.indptr, self.indices, self.data0 = (a.copy() for a in A.getValuesCSR())
         n_rows = self.indptr.size - 1
         rows = np.repeat(np.arange(n_rows), np.diff(self.indptr))
-        cz, cv = compat.cell_dofs(Z), compat.cell_dofs(V)               # (cells, 3) vertices
+        # int64: the vertex-pair keys below reach nv^2 (4.4e9 at n = 256, past int32)
+        cz, cv = (compat.cell_dofs(S).astype(np.int64) for S in (Z, V))  # (cells, 3) vertices
         Q = compat.scalar_dg0(msh)
         cq = compat.cell_dofs(Q)[:, 0]                                  # the cell's DG0 dof
         nc, nz, nq = cz.shape[0], zeta.x.array.size, Q.dofmap.index_map.size_local

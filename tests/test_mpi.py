@@ -25,7 +25,8 @@ def test_convergence_table_serial_equals_two_ranks(tmp_path):
     args = ["converge", "2.1-ex1", "--ref-n", "20", "--ref-k", "0.05", "--n", "5", "10",
             "--k", "0.1", "--T", "0.5", "--quiet"]
     run_cli(args + ["--out", tmp_path / "s"])
-    run_cli(args + ["--out", tmp_path / "p"], np_=2)
+    # the layout with the reference on all ranks (the default, one rank, is tested below)
+    run_cli(args + ["--reference-ranks", "all", "--out", tmp_path / "p"], np_=2)
     s = json.loads((tmp_path / "s" / "summary.json").read_text())
     p = json.loads((tmp_path / "p" / "summary.json").read_text())
     assert p["mpi_size"] == 2
@@ -37,6 +38,28 @@ def test_convergence_table_serial_equals_two_ranks(tmp_path):
     assert errs[0] > errs[1] > 0
     for name in ("errors.csv", "errors.md", "convergence.png"):
         assert (tmp_path / "p" / name).exists()
+
+
+@pytest.mark.mpi
+def test_convergence_reference_on_one_rank(tmp_path):
+    """The layout with the reference serially on rank 0 and the cells on the other ranks
+    (--reference-ranks 1, issue 18) gives the table of the serial study, on 2 and 3 ranks; the
+    3.3 reference uses the serial-only zeta-linear matrices there."""
+    args = ["converge", "3.3-ex1", "--ref-n", "16", "--ref-k", "0.002", "--n", "4", "8",
+            "--k", "0.01", "0.004", "--T", "0.1", "--quiet"]
+    run_cli(args + ["--out", tmp_path / "s"])
+    s = json.loads((tmp_path / "s" / "summary.json").read_text())
+    for np_ in (2, 3):
+        run_cli(args + ["--reference-ranks", "1", "--out", tmp_path / f"p{np_}"], np_=np_)
+        p = json.loads((tmp_path / f"p{np_}" / "summary.json").read_text())
+        assert p["mpi_size"] == np_ and p["reference"]["ranks"] == 1
+        owners = {owner for _, _, owner in p["serial_cells"]["rank_of_cell"]}
+        assert owners == set(range(1, np_))  # rank 0 runs the reference alone
+        for rs, rp in zip(s["errors"], p["errors"]):
+            assert (rs["n"], rs["k"]) == (rp["n"], rp["k"])
+            assert rp["error"] == pytest.approx(rs["error"], rel=1e-8)
+            assert rp["error_at_T"] == pytest.approx(rs["error_at_T"], rel=1e-8)
+    assert s["errors"][0]["error"] > s["errors"][-1]["error"] > 0
 
 
 @pytest.mark.mpi

@@ -7,7 +7,8 @@
 
 The damage matrix is constant (assembled and factorised once). The elasticity matrix changes
 with zeta_n and is re-assembled in place each step; it is solved by CG preconditioned with the
-exact (MUMPS) factorisation of an earlier step's matrix, rebuilt only when CG needs more than
+exact factorisation of an earlier step's matrix (PETSc's Cholesky serially, MUMPS LU in
+parallel: solvers.lagged_direct), rebuilt only when CG needs more than
 MECH_REFACTOR_ITS iterations (``-mech_ksp_type preonly`` gives a fresh factorisation per step).
 The damage field that factorisation was built from is part of the checkpoint, so that a restart
 rebuilds the same preconditioner and resumes exactly. The run stops when min zeta_n <= zeta_star
@@ -28,7 +29,7 @@ from ..forms.elastic_damage import equilibrium_forms, stress
 from ..boundary import bilateral_plane_faces, clamped
 from ..constitutive import eps, von_mises
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..solvers import LAGGED_DIRECT, LinearSolver
+from ..solvers import LinearSolver, lagged_direct
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
@@ -65,7 +66,8 @@ class ElasticDamage(TimeStepper):
         # on coordinate-plane faces (rollers of the 3-D uniaxial-strain check, issue 17)
         bcs = [clamped(V, tags, GAMMA_D)] + bilateral_plane_faces(V, tags, GAMMA_C)
         # 2-D: lagged direct; 3-D: CG + AMG with the rigid-body near-nullspace (scalable.py)
-        defaults, refactor_its = scalable.mech_config(V, LAGGED_DIRECT, MECH_REFACTOR_ITS)
+        defaults, refactor_its = scalable.mech_config(V, lagged_direct(msh.comm),
+                                                      MECH_REFACTOR_ITS)
         self.mech = LinearSolver(a, L, bcs, mech_prefix, self.context, defaults=defaults,
                                  refactor_after_its=refactor_its)
         scalable.prepare_mech(self.mech, V)
