@@ -55,6 +55,7 @@ out = Path(a.out or ("results/figures-quick" if a.quick else "results/figures"))
 index = reproduce.run_figures(mode, out, a.np, a.only, a.resume)
 shared = share_pair_scales(out, index)
 failed = [r for r in index["runs"] if r["returncode"] != 0]
-print(f"{len(index['figures'])} figures from {len(index['runs'])} runs in {index['wall_time_s']} s "
+print(f"{len(index['figures'])} figures from {len(index['runs'])} runs in "
+      f"{index['wall_time_this_invocation_s']} s (runs: {index['wall_time_s']} s in two lanes) "
       f"({mode} mode, {a.np} ranks) -> {out}; failed runs: {[r['example'] for r in failed] or 'none'}; "
       f"pairs on shared scales: {len(shared)}")

@@ -8,10 +8,11 @@ reference mesh (:func:`post.nested_transfer`, P1 or DG0) and its error is measur
               (default ||u_ref - u_hk||_V + ||zeta_ref - zeta_hk||_Y; each problem sets the
               norm its thesis table uses, e.g. ||sigma||_Q for 2.4, ||v||_H for 3.1),
 
-so no reference history is stored. Everything runs under MPI: the reference and the large
-cells on all ranks, the cells with n <= SERIAL_CELL_MAX_N serially, shared out among the ranks
-(a small mesh steps faster on one rank); each owner sends its cell's nodal values to the
-reference ranks for the measurement, and the norm is one product with a Gram matrix.
+so no reference history is stored. Everything runs under MPI. By default (reference_ranks 1,
+issue 18) the reference runs serially on rank 0 and every cell serially on the other ranks,
+which send their cells' nodal values to rank 0 without waiting for it; with ``--reference-ranks
+all`` the reference and the cells n > SERIAL_CELL_MAX_N run on all ranks and the smaller cells
+serially, shared out among all ranks. The norm is one product with a Gram matrix.
 Outputs: ``errors.csv``, ``errors.md``, ``convergence.png`` (log-log error vs h + k with the
 fitted rate) and ``summary.json``.
 """

@@ -35,6 +35,18 @@ def _wall_times(doc, fig_index, conv_index):
     doc.markdown_table("| run | status | wall time [s] |\n|---|---|---|\n"
                        + "".join(f"| {name} | {status} | {t:.1f} |\n" for name, status, t in rows)
                        + f"| **total** | | **{total:.0f}** ({total / 3600:.2f} h) |\n")
+    check = REFERENCE / "reproduction_issue18" / "reproduction_check.md"
+    if check.is_file():
+        doc.para("**The committed one-command reproduction** (`make convergence NP=2` and `make "
+                 "figures NP=2` on one checkout, each once, quiet machine; issue 18: together at "
+                 "most 40 minutes, every error equal to the committed tables to 1e-6), checked "
+                 f"by `python benchmarks/reproduction_check.py`, from `{_shown(check)}`:")
+        text = check.read_text()
+        table = text[:text.index("\n\n")]
+        doc.markdown_table(table + "\n")
+        for line in text[text.index("\n\n"):].strip().splitlines():
+            if line.strip():
+                doc.para(line.lstrip("* "))
 
 
 def _performance(doc, results):
@@ -94,7 +106,7 @@ def _step_floor(doc):
     folder = REFERENCE / "step_floor"
     # the newest record of each size first: this session's damage fast path (``_vi_after``)
     tables = [(label, next((folder / f"step_floor_{tag}{suffix}.md"
-                            for suffix in ("_vi_after", "_after")
+                            for suffix in ("_s8", "_vi_after", "_after")
                             if (folder / f"step_floor_{tag}{suffix}.md").is_file()), None))
               for label, tag in (("about 4k dofs (n = 45)", "n45"),
                                  ("reference size (n = 255, 131k dofs)", "n255"))]

@@ -177,53 +177,55 @@ def _finish(index: dict, key: str, start: float):
 
 def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, reading=None) -> dict:
     """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``. With
-    ``resume``, jobs that completed in an earlier invocation (same mode) are kept, not rerun."""
+    ``resume``, jobs that completed in an earlier invocation (same mode) are kept, not rerun.
+
+    Two lanes (issue 18): the SERIAL jobs (the wrench, 3.3-ex2: long serial loops) run one
+    after the other on one rank, while the other jobs run beside them on np_ - 1 ranks, and on
+    np_ ranks once the serial lane is done. index.json lists the runs in catalogue order."""
+    import threading
     out.mkdir(parents=True, exist_ok=True)
     runs = out / "runs"
     done = _previous_entries(out, "runs", mode) if resume else {}
     old_figures = json.loads((out / "index.json").read_text())["figures"] if done else []
     index = {"mode": mode, "mpi_size": np_, "runs": [], "figures": []}
     start = time.perf_counter()
-    for job in figure_jobs(mode, reading):
-        if only and job.example not in only:
-            continue
+    jobs = [job for job in figure_jobs(mode, reading) if not only or job.example in only]
+    results, lock = {}, threading.Lock()  # job name -> (entry, figures)
+
+    def write_index():
+        with lock:
+            entries = [results[j.name] for j in jobs if j.name in results]
+            index["runs"] = [e for e, _ in entries]
+            index["figures"] = [f for _, figs in entries for f in figs]
+            (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+
+    def run_job(job, ranks):
         if job.name in done:
-            index["runs"].append(done[job.name])
-            index["figures"] += [f for f in old_figures if f["example"] == job.example
-                                 and f["variant"] == job.variant]
+            figs = [f for f in old_figures if f["example"] == job.example
+                    and f["variant"] == job.variant]
+            with lock:
+                results[job.name] = (done[job.name], figs)
             print(f"[figures] {job.name}: done earlier ({done[job.name]['wall_time_s']} s)")
+            return
+        results[job.name] = _figure_run(job, ranks, runs, out, resume)
+        print(f"[figures] {job.name}: exit {results[job.name][0]['returncode']}, "
+              f"{results[job.name][0]['wall_time_s']:.1f} s", flush=True)
+        write_index()
+
+    serial = [job for job in jobs if job.example in SERIAL]
+    lane = threading.Thread(target=lambda: [run_job(job, 1) for job in serial])
+    two_lanes = np_ > 1 and bool(serial)
+    if two_lanes:
+        lane.start()
+    for job in jobs:
+        if job.example in SERIAL and two_lanes:
             continue
-        run_dir = runs / job.name
-        # an interrupted run of an earlier invocation goes on from its last checkpoint
-        restart = resume and (run_dir / "checkpoint.json").is_file()
-        if run_dir.exists() and not restart:
-            shutil.rmtree(run_dir)
-        run_dir.mkdir(parents=True, exist_ok=True)
-        command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir),
-                   *(["--restart"] if restart else [])]
-        ranks = 1 if job.example in SERIAL else np_
-        code, wall, _ = _launch(command, ranks, run_dir / "log.txt")
-        entry = {"example": job.example, "variant": job.variant, "command": _display(command, ranks),
-                 "returncode": code, "wall_time_s": round(wall, 2), "folder": str(run_dir)}
-        summary = run_dir / "summary.json"
-        if summary.is_file():
-            s = json.loads(summary.read_text())
-            entry.update(status=s.get("status"), title=s.get("title"),
-                         figures=[f["file"] for f in s["outputs"]["figures"]])
-            for fig in s["outputs"]["figures"]:
-                target = _figure_name(fig["file"], job)
-                shutil.copy(run_dir / fig["file"], out / target)
-                index["figures"].append({"file": target, "source": fig["file"],
-                                         "example": job.example,
-                                         "variant": job.variant, "title": s.get("title"),
-                                         "command": entry["command"], **{
-                                             k: fig[k] for k in ("t", "amplification") if k in fig}})
-                if "amplification" in fig:  # the factor the figure is drawn with (post.py)
-                    index["figures"][-1]["amplification"] = figstyle.drawn_amplification(
-                        fig["amplification"])
-        index["runs"].append(entry)
-        print(f"[figures] {job.name}: exit {code}, {wall:.1f} s", flush=True)
-        (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+        ranks = 1 if job.example in SERIAL else \
+            (max(1, np_ - 1) if two_lanes and lane.is_alive() else np_)
+        run_job(job, ranks)
+    if two_lanes:
+        lane.join()
+    write_index()
     if (not only or "2.1-ex3" in only) and "2.1-ex3-force-displacement" not in done:
         _bridge_force_displacement(mode, out, np_, index)
     elif "2.1-ex3-force-displacement" in done:
@@ -232,6 +234,37 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, rea
     _finish(index, "runs", start)
     (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
     return index
+
+
+def _figure_run(job, ranks, runs, out, resume) -> tuple:
+    """One figure job: (its index entry, the figures it copied into ``out``)."""
+    run_dir = runs / job.name
+    # an interrupted run of an earlier invocation goes on from its last checkpoint
+    restart = resume and (run_dir / "checkpoint.json").is_file()
+    if run_dir.exists() and not restart:
+        shutil.rmtree(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir),
+               *(["--restart"] if restart else [])]
+    code, wall, _ = _launch(command, ranks, run_dir / "log.txt")
+    entry = {"example": job.example, "variant": job.variant, "command": _display(command, ranks),
+             "returncode": code, "wall_time_s": round(wall, 2), "folder": str(run_dir)}
+    figures = []
+    summary = run_dir / "summary.json"
+    if summary.is_file():
+        s = json.loads(summary.read_text())
+        entry.update(status=s.get("status"), title=s.get("title"),
+                     figures=[f["file"] for f in s["outputs"]["figures"]])
+        for fig in s["outputs"]["figures"]:
+            target = _figure_name(fig["file"], job)
+            shutil.copy(run_dir / fig["file"], out / target)
+            figures.append({"file": target, "source": fig["file"], "example": job.example,
+                            "variant": job.variant, "title": s.get("title"),
+                            "command": entry["command"],
+                            **{k: fig[k] for k in ("t", "amplification") if k in fig}})
+            if "amplification" in fig:  # the factor the figure is drawn with (post.py)
+                figures[-1]["amplification"] = figstyle.drawn_amplification(fig["amplification"])
+    return entry, figures
 
 
 def _bridge_force_displacement(mode, out, np_, index):

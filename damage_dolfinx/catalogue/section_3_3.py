@@ -13,7 +13,10 @@ from ..parameters import ModelParameters
 #: G33/1.8: default time steps of Examples 2-3, 0.8 k_max or below and dividing T, from
 #: stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)
 K_EX2 = 6.25e-5
-K_EX3 = 1.0e-5
+#: Example 3: 0.8 k_max (k_max = 1.3662e-5 at h = 0.15) rounded down to a divisor of T = 6.5,
+#: 594 703 steps: the k of benchmarks/wrench_3_3.py and of its committed reference (issue 18:
+#: the wrench keeps k = 0.8 k_max; it was 1e-5 = 0.73 k_max, 650 000 steps, until then)
+K_EX3 = 6.5 / 594_703
 #: issue 18: the wrench writes a history.csv row every 50 steps (5e-4 s at k = 1e-5; about
 #: 13 000 rows for T = 6.5 instead of 650 000); the maximal interpenetration of summary.json is
 #: still tracked at every step (runner.py, ``--history-every`` / ``--set history_every=1``)
@@ -163,10 +166,10 @@ def examples():
             "u.nu with nu the body's outward normal (pointing into the hole); gap = 0",
             "G35/G42: Gamma_D empty; the mass term keeps each velocity system definite (CG + "
             "Jacobi, no direct solver needed)",
-            f"G33: k = {K_EX3:g} by default (0.73 k_max, 650 000 steps for T = 6.5): k_max = "
-            "1.37e-5 at h = 0.15 (stability helper, omega_max^2 = 2.5e10, inertia-limited by the "
-            "h/3 = 0.05 elements at the hexagon), 0.8 k_max = 1.09e-5, rounded down to a divisor "
-            "of T",
+            f"G33: k = {K_EX3:.6g} by default (T / 594 703, 0.8 k_max rounded down to a "
+            "divisor of T = 6.5): k_max = 1.37e-5 at h = 0.15 (stability helper, omega_max^2 = "
+            "2.5e10, inertia-limited by the h/3 = 0.05 elements at the hexagon); the k of "
+            "benchmarks/wrench_3_3.py (1e-5, 650 000 steps, before issue 18)",
             "damage step: every increment is solved (damage_atol_rel = 0: the obstacle "
             "step's absolute tolerance is snes_atol = 1e-12, not 1e-9 ||l||, which kept zeta "
             "unchanged whenever the increment's residual was smaller: on the wrench the damage "
