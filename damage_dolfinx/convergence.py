@@ -53,10 +53,11 @@ class _CoarseRun:
         the others, which only send their cells' values, without waiting: ``outbox`` holds
         the sends in flight, shared by the cells of a rank)."""
         self.h, self.comm, self.norms = h, comm, norms
-        self.ref_rank, self.world, self._grid, self._send = ref_rank, world, grid, {}
-        self.outbox = outbox
+        self.ref_rank, self.world, self.outbox = ref_rank, world, outbox
         self.components = []
-        if ref is None:
+        if ref is None:  # a rank without the reference: the coarse halves of its own cells
+            self._send = [post.nested_transfer(f.function_space, None, grid)
+                          for _, f, _ in self.stepper.error_components] if self.mine else []
             return
         coarse = dict((name, f) for name, f, _ in self.stepper.error_components) \
             if self.mine else {}
@@ -79,11 +80,8 @@ class _CoarseRun:
         a reference on rank 0 alone, the owner sends its grid values there, point to point)."""
         if self.ref_rank is not None and self.world.rank != self.ref_rank:
             if self.mine:  # send each component (the reference's order: same example)
-                for name, f, _ in self.stepper.error_components:
-                    if name not in self._send:
-                        self._send[name] = post.nested_transfer(f.function_space, None,
-                                                                self._grid)
-                    values = np.ascontiguousarray(self._send[name].grid_values(f))
+                for (_, f, _), coarse_side in zip(self.stepper.error_components, self._send):
+                    values = np.ascontiguousarray(coarse_side.grid_values(f))
                     self.outbox.append((self.world.Isend(values, dest=self.ref_rank, tag=7),
                                         values))
                 if len(self.outbox) > MAX_SENDS_IN_FLIGHT:  # bound the memory of a fast rank
