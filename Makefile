@@ -10,6 +10,8 @@ MPIRUN := mpirun -n $(NP)
 export OMPI_ALLOW_RUN_AS_ROOT := 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
+# the same for OpenMPI 5 (PRRTE: Debian 13 and later)
+export PRTE_MCA_rmaps_default_mapping_policy := :oversubscribe
 export OMP_NUM_THREADS := 1
 export MPLBACKEND := Agg
 

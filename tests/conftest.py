@@ -7,8 +7,13 @@ import sys
 import numpy as np
 import pytest
 
+# oversubscription: OpenMPI 4 (Debian 12) reads OMPI_MCA_rmaps_base_oversubscribe, OpenMPI 5
+# (Debian 13 and later, PRRTE) PRTE_MCA_rmaps_default_mapping_policy; a 3-rank test needs it on
+# a 2-core runner
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
+           OMPI_MCA_rmaps_base_oversubscribe="1",
+           PRTE_MCA_rmaps_default_mapping_policy=":oversubscribe", OMP_NUM_THREADS="1",
+           MPLBACKEND="Agg")
 
 
 def run_cli(args, np_=1, check=True, timeout=600):
