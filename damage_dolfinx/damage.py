@@ -14,7 +14,8 @@ from . import compat
 from .constitutive import Psi_q, eta_star, split_norms_sq
 from .forms.damage import damage_step_forms
 from .obstacle import CHOLESKY_MAX_DOFS, ObstacleFastPath, fast_path_options
-from .solvers import ConvergenceError, LinearSolver, SNESSolver, SolveContext, spd_direct
+from .solvers import (DIRECT, ConvergenceError, LinearSolver, SNESSolver, SolveContext,
+                      serial_cholesky)
 
 
 def phi_A(e, z, p):
@@ -78,13 +79,11 @@ class DamageStep:
                                  k, kappa)
         self.zeta, self.zeta_old, self.obstacle = zeta, zeta_old, obstacle
         if not obstacle:
-            # linear_defaults: KSP options of the PDE form (None: direct; the matrix
-            # M + k kappa K is SPD: PETSc's Cholesky serially (spd_direct, issue 18), MUMPS LU
-            # in parallel; 3-D: scalable.py)
-            serial = V.mesh.comm.size == 1
+            # linear_defaults: KSP options of the PDE form (None: direct, the matrix
+            # M + k kappa K being SPD by PETSc's Cholesky serially, issue 18; 3-D: scalable.py)
             self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True,
                                        defaults=linear_defaults or
-                                       (spd_direct(V.mesh.comm) if serial else None))
+                                       serial_cholesky(V.mesh.comm, DIRECT))
             return
         enabled, solver = fast_path_options(prefix)  # a bad option is refused before any work
         self.a, self.L = compat.form(a), compat.form(L)

@@ -91,14 +91,19 @@ LAGGED_DIRECT = {"ksp_type": "cg", "ksp_rtol": 1e-12, "ksp_atol": 1e-50, "ksp_ma
                  "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 
 
-def lagged_direct(comm) -> dict:
-    """LAGGED_DIRECT with PETSc's own Cholesky serially (the lagged matrices are SPD): its
-    triangular solves are 2-3x faster than MUMPS's (spd_direct). Measured at the convergence
-    references, serially (issue 18): 2.1-ex1 at n = 160 91 -> 47 ms per step, 2.3-ex1 at
-    n = 256 306 -> 181 ms. MUMPS LU in parallel, as before."""
+def serial_cholesky(comm, options: dict) -> dict:
+    """``options`` (a factorisation by MUMPS LU) with PETSc's own Cholesky serially, for SPD
+    matrices: its triangular solves are 2-3x faster than MUMPS's (spd_direct). Unchanged in
+    parallel. Measured at the convergence references, serially (issue 18): 2.1-ex1 at n = 160
+    91 -> 47 ms per step, 2.3-ex1 at n = 256 306 -> 181 ms."""
     if comm.size > 1:
-        return dict(LAGGED_DIRECT)
-    return {**LAGGED_DIRECT, "pc_type": "cholesky", "pc_factor_mat_solver_type": "petsc"}
+        return dict(options)
+    return {**options, "pc_type": "cholesky", "pc_factor_mat_solver_type": "petsc"}
+
+
+def lagged_direct(comm) -> dict:
+    """LAGGED_DIRECT, with PETSc's Cholesky serially (the lagged matrices are SPD)."""
+    return serial_cholesky(comm, LAGGED_DIRECT)
 
 
 class LinearSolver:
@@ -286,16 +291,11 @@ def _relative_change(A, P) -> float:
     return change
 
 
-#: Newton with CG preconditioned by a lagged factorisation of an earlier Jacobian (symmetric
-#: Jacobians whose active set rarely changes, e.g. normal compliance): see NonlinearSolver
-#: (which takes the factorisation of lagged_direct: PETSc's Cholesky serially).
-NEWTON_LAGGED = {**NEWTON, **LAGGED_DIRECT}
-
-
 class NonlinearSolver:
     """Newton (PETSc SNES) for F(u; w) = 0 with Dirichlet conditions, Jacobian from UFL.
 
-    With ``refactor_after_its`` (and a Krylov KSP, default options NEWTON_LAGGED) the
+    With ``refactor_after_its`` (and a Krylov KSP, default options NEWTON with lagged_direct:
+    symmetric Jacobians whose active set rarely changes, e.g. normal compliance) the
     factorisation of an earlier Jacobian preconditions the current one and is rebuilt only when
     the previous linear solve needed more than that many iterations or the Jacobian changed by
     more than ``jacobian_change_tol`` (Frobenius, relative; 1e-10, i.e. any change): Newton
