@@ -11,7 +11,16 @@ mechanical operator here): one sparse matrix-vector product (SpMV), one CG + Jac
 iteration, and one pair of triangular solves with its Cholesky factor (the solver the
 factorised schemes use), each the fastest of 5 blocks. The damage step (DamageStep.solve:
 right-hand side and solve) is timed on its own (split "damage_step"), with the obstacle fast
-path's hits and SNES fallbacks (damage_dolfinx/obstacle.py). Serial. Writes
+path's hits and SNES fallbacks (damage_dolfinx/obstacle.py).
+
+The floor of the issue is ONE solve per step; the schemes need several (a staggered damage and
+mechanical solve, Newton iterations, CG iterations with a lagged factor). So PETSc's own event
+log also counts, per step, the triangular-solve pairs (MatSolve), the SpMVs (MatMult,
+MatMultTranspose) and the factorisations, and times PETSc's numerical kernels (the leaf events
+KERNEL_EVENTS: SpMV, triangular solves, factorisations, vector operations): "step over its
+solves" = step / (MatSolve per step x one Cholesky solve), "step over its kernels" = step /
+that kernel time, i.e. how far the step is above the arithmetic its own scheme performs.
+Serial. Writes
 benchmarks/reference_output/step_floor/step_floor_n<N>.json and .md (--out to change).
 """
 import argparse
@@ -29,6 +38,14 @@ from damage_dolfinx.constitutive import eps
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import best, profile_rows, write_record  # noqa: E402
+
+#: PETSc leaf events (no nesting among them): the arithmetic of a step
+KERNEL_EVENTS = ["MatMult", "MatMultAdd", "MatMultTranspose", "MatSolve", "MatCholFctrSym",
+                 "MatCholFctrNum", "MatLUFactorSym", "MatLUFactorNum", "MatGetOrdering",
+                 "VecDot", "VecTDot", "VecMDot", "VecNorm", "VecScale", "VecCopy", "VecSet",
+                 "VecAXPY", "VecAYPX", "VecAXPBYCZ", "VecWAXPY", "VecMAXPY",
+                 "VecPointwiseMult", "VecReciprocal"]
+PETSc.Log.begin()
 
 PROBLEMS = ["2.1-ex1", "2.2-ex1", "2.3-ex1", "2.4-ex1", "3.1-ex1", "3.2-ex1", "3.3-ex1",
             "3.3-ex3"]
@@ -75,6 +92,15 @@ def floors(V) -> dict:
     return out
 
 
+def petsc_events() -> dict:
+    """Cumulative (count, seconds) of KERNEL_EVENTS."""
+    out = {}
+    for name in KERNEL_EVENTS:
+        info = PETSc.Log.Event(name).getPerfInfo()
+        out[name] = (info["count"], info["time"])
+    return out
+
+
 def _timed(solve, clock):
     def wrapper():
         start = time.perf_counter()
@@ -99,12 +125,17 @@ def profile(example) -> dict:
     if damage is not None:  # the damage step timed on its own (right-hand side + solve)
         damage.solve = _timed(damage.solve, damage_clock)
     counts0 = damage.counts() if hasattr(damage, "counts") else {}
+    events0 = petsc_events()
     wall0, cpu0 = time.perf_counter(), time.process_time()
     for _ in range(args.steps):
         s.advance()
         s.scalars()  # what the runner asks after every step (history.csv)
     wall = (time.perf_counter() - wall0) / args.steps
     cpu = (time.process_time() - cpu0) / args.steps
+    events = {name: ((c - events0[name][0]) / args.steps, (t - events0[name][1]) / args.steps)
+              for name, (c, t) in petsc_events().items()}
+    per_step = lambda *names: sum(events[n][0] for n in names)  # noqa: E731
+    kernel_s = sum(t for _, t in events.values())
     split = {key: 1e3 * (value - timings0.get(key, 0.0)) / args.steps
              for key, value in getattr(s, "timings", {}).items()
              if isinstance(value, float) and key != "stability"}
@@ -121,22 +152,33 @@ def profile(example) -> dict:
             "floor_us": {key: round(v, 2) for key, v in floor.items() if key != "dofs"},
             "step_over_spmv": step_us / floor["spmv_us"],
             "step_over_cg_iteration": step_us / floor["cg_iteration_us"],
-            "step_over_cholesky_solve": step_us / floor["cholesky_solve_us"]}
+            "step_over_cholesky_solve": step_us / floor["cholesky_solve_us"],
+            "per_step": {"solves": per_step("MatSolve"),
+                         "spmv": per_step("MatMult", "MatMultAdd", "MatMultTranspose"),
+                         "factorisations": per_step("MatCholFctrNum", "MatLUFactorNum"),
+                         "kernel_ms": 1e3 * kernel_s},
+            "step_over_its_solves": step_us / max(per_step("MatSolve"), 1.0)
+            / floor["cholesky_solve_us"],
+            "step_over_its_kernels": wall / kernel_s if kernel_s > 0 else float("nan")}
 
 
 rows = profile_rows(PROBLEMS, args.only, profile)
 stem = f"step_floor_n{args.n}" + (f"_{args.label}" if args.label else "")
 lines = ["| example | dofs (u) | ms per step (wall / CPU) | split (ms) | SpMV / CG it / Cholesky "
          "solve (us) | step over SpMV / CG it / Cholesky solve | damage fast path: hits "
-         "(unchanged) / SNES fallbacks |", "|---|---|---|---|---|---|---|"]
+         "(unchanged) / SNES fallbacks | per step: solves / SpMVs / factorisations / PETSc "
+         "kernels (ms) | step over its solves / its kernels |",
+         "|---|---|---|---|---|---|---|---|---|"]
 for r in rows:
     f = r["floor_us"]
     split = ", ".join(f"{k} {v:.2f}" for k, v in r["split_ms_per_step"].items())
-    c = r["damage_fast_path"]
+    c, q = r["damage_fast_path"], r["per_step"]
     fast = f"{c['hits']} ({c['unchanged']}) / {c['fallbacks']}" if c else "-"
     lines.append(f"| {r['example']} | {r['dofs_u']} | {r['wall_ms_per_step']:.2f} / "
                  f"{r['cpu_ms_per_step']:.2f} | {split} | {f['spmv_us']:.0f} / "
                  f"{f['cg_iteration_us']:.0f} / {f['cholesky_solve_us']:.0f} | "
                  f"{r['step_over_spmv']:.0f} / {r['step_over_cg_iteration']:.0f} / "
-                 f"{r['step_over_cholesky_solve']:.1f} | {fast} |")
+                 f"{r['step_over_cholesky_solve']:.1f} | {fast} | {q['solves']:.1f} / "
+                 f"{q['spmv']:.1f} / {q['factorisations']:.2f} / {q['kernel_ms']:.2f} | "
+                 f"{r['step_over_its_solves']:.1f} / {r['step_over_its_kernels']:.1f} |")
 write_record(args.out, stem, rows, lines)
