@@ -30,7 +30,7 @@ from ..damage import DamageStep, source
 from ..forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
 from ..memory import MemoryKernel, MemoryTerm
 from ..parameters import InputError
-from ..solvers import NEWTON, NonlinearSolver
+from ..solvers import NEWTON, NonlinearSolver, constant_cell_jacobian
 from .base import ProblemData, TimeStepper
 
 
@@ -95,9 +95,12 @@ class ViscoelasticMemoryContact(TimeStepper):
             modes = scalable.rigid_body_modes(V)
             for A in (J, P):
                 A.setNearNullSpace(modes)
-        else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation
+        else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation; the Jacobian
+            # is the constant (B eps(du), eps(w)) plus the Gamma_C term, which alone is
+            # assembled per Newton step (issue 18: 2.3-ex1 at n = 160, 31 ms of 99 per step)
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
-                                        refactor_after_its=MECH_REFACTOR_ITS)
+                                        refactor_after_its=MECH_REFACTOR_ITS,
+                                        jacobian_split=constant_cell_jacobian(F, self.u))
 
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
@@ -137,7 +140,9 @@ class ViscoelasticMemoryContact(TimeStepper):
         """Base scalars, the RMS penetration (u.nu - gap)_+ over Gamma_C and ||sigma_n||_Q."""
         out = super().scalars()
         out["stress_L2"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
-        length = compat.assemble_scalar(self._contact_length, self.comm)
+        if not isinstance(self._contact_length, float):  # |Gamma_C|, assembled once
+            self._contact_length = compat.assemble_scalar(self._contact_length, self.comm)
+        length = self._contact_length
         pen = compat.assemble_scalar(self._penetration, self.comm)
         out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
         return out
