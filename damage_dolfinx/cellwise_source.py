@@ -80,9 +80,8 @@ class CellwiseSource:
         """b = M zeta_old + k Q phi_c (owned entries; no ghost update is needed)."""
         p = self.p
         self.G.mult(self.u, self.e)
-        e, phi = self.e.array, self.phi.array
-        np.square(e, out=e)
-        np.sum(e.reshape(-1, self.components), axis=1, out=phi)  # |eps_c|^2
+        e, phi = self.e.array.reshape(-1, self.components), self.phi.array
+        np.einsum("ij,ij->i", e, e, out=phi)  # |eps_c|^2 (one pass; issue 18)
         np.minimum(phi, p.q_star, out=phi)
         phi *= -0.5 * p.lam_u
         phi -= p.lam_w

@@ -97,12 +97,18 @@ class ZetaLinearMatrix:
         self._C = _petsc_csr(self.C, A.getComm())
         self._Pt = _petsc_csr(self.P.T, A.getComm())
         self._zbar = self._C.createVecLeft()
+        # each buffer is also the value array of a PETSc matrix W_mat (the pattern of A), so
+        # the right-hand side multiplies with W(zeta_{n-1}) without copying it; the third
+        # buffer takes a zeta that is neither of the last two (the first step, a restart)
         self._slots = []
-        for _ in range(2):
+        for _ in range(3):
             z_i, W_i = np.zeros(nz), np.zeros(self.data0.size)
             self._slots.append({"zeta": None, "z": z_i, "W": W_i,
                                 "z_vec": PETSc.Vec().createWithArray(z_i, comm=A.getComm()),
-                                "W_vec": PETSc.Vec().createWithArray(W_i, comm=A.getComm())})
+                                "W_vec": PETSc.Vec().createWithArray(W_i, comm=A.getComm()),
+                                "W_mat": PETSc.Mat().createAIJWithArrays(
+                                    A.getSize(), (self.indptr, self.indices, W_i),
+                                    comm=A.getComm())})
         self._current = 0
         self._check(A, a_visc, zeta, bcs, keep)
         # the PETSc matrix shares its CSR value array: the update writes it in place
@@ -135,18 +141,20 @@ class ZetaLinearMatrix:
         slot["z"][:] = zeta_values
         self._C.mult(slot["z_vec"], self._zbar)
         self._Pt.multTranspose(self._zbar, slot["W_vec"])
+        slot["W_mat"].assemble()  # new values: new object state
         slot["zeta"] = slot["z"]
         return slot["W"]
 
-    def product(self, zeta_values):
-        """W(zeta) values, reused from the last two updates where zeta is theirs (the
-        right-hand side of step n needs W(zeta_{n-1}), which the update of step n-1 computed).
-        The array is the update's buffer: valid until the next update but one."""
-        for i in (1 - self._current, self._current):
+    def product(self, zeta_values) -> PETSc.Mat:
+        """W(zeta) as a PETSc matrix, reused from the last two updates where zeta is theirs
+        (the right-hand side of step n needs W(zeta_{n-1}), which the update of step n-1
+        computed), else computed into the third buffer. Valid until the next update but one."""
+        for i in (1 - self._current, self._current, 2):
             slot = self._slots[i]
             if slot["zeta"] is not None and np.array_equal(zeta_values, slot["zeta"]):
-                return slot["W"]
-        return self.viscous(zeta_values)
+                return slot["W_mat"]
+        self.viscous(zeta_values, self._slots[2])
+        return self._slots[2]["W_mat"]
 
     def forget(self):
         """The next update() recomputes W (benchmarks time it)."""
@@ -193,10 +201,8 @@ class VelocitySolver(LinearSolver):
         self.rhs = rhs
         if rhs is not None:
             self.l_boundary = compat.form(rhs[0])
-            self._el_data, self._el_zeta = np.zeros_like(f.data0), None
-            self.M, self.K = (PETSc.Mat().createAIJWithArrays(self.A.getSize(), (
-                f.indptr, f.indices, data), comm=self.A.getComm()) for data in (f.data0,
-                                                                               self._el_data))
+            self.M = PETSc.Mat().createAIJWithArrays(self.A.getSize(), (
+                f.indptr, f.indices, f.data0), comm=self.A.getComm())
             self._tmp = self.b.duplicate()
             self._tmp.set(1.0)  # homogeneous Dirichlet data (clamped): the lifting adds 0
             compat.set_bc(self._tmp, self.bcs)
@@ -211,12 +217,7 @@ class VelocitySolver(LinearSolver):
             return super().assemble_rhs()
         start = time.perf_counter()
         _, v_old, u_old, zeta_old, m_visc = self.rhs
-        z, f = zeta_old.x.array, self.fast
-        if self._el_zeta is None or not np.array_equal(z, self._el_zeta):
-            self._el_zeta = z.copy()
-            Gz = f.product(z)
-            np.multiply(Gz, m_visc, out=self._el_data)                  # K_B(zeta_{n-1})
-            self.K.assemble()
+        W = self.fast.product(zeta_old.x.array)                        # W(zeta_{n-1})
         b, tmp = self.b, self._tmp
         with b.localForm() as bl:
             bl.set(0.0)
@@ -224,8 +225,8 @@ class VelocitySolver(LinearSolver):
         v_vec, u_vec = self._rhs_vecs
         self.M.mult(v_vec, tmp)                                         # rho/k M v_{n-1}
         b.axpy(1.0, tmp)
-        self.K.mult(u_vec, tmp)                                         # K_B(zeta_{n-1}) u_{n-1}
-        b.axpy(-1.0, tmp)
+        W.mult(u_vec, tmp)                                    # K_B(zeta_{n-1}) = m_visc W
+        b.axpy(-m_visc, tmp)
         if self._lifting:  # not reached by the catalogue (clamped or no Gamma_D)
             compat.apply_lifting(b, self.a, self.bcs)
             compat.set_bc(b, self.bcs)
