@@ -106,7 +106,7 @@ def _step_floor(doc):
     folder = REFERENCE / "step_floor"
     # the newest record of each size first: this session's damage fast path (``_vi_after``)
     tables = [(label, next((folder / f"step_floor_{tag}{suffix}.md"
-                            for suffix in ("_s8", "_vi_after", "_after")
+                            for suffix in ("_s9", "_s8", "_vi_after", "_after")
                             if (folder / f"step_floor_{tag}{suffix}.md").is_file()), None))
               for label, tag in (("about 4k dofs (n = 45)", "n45"),
                                  ("reference size (n = 255, 131k dofs)", "n255"))]
@@ -118,7 +118,12 @@ def _step_floor(doc):
              "the first two, history scalars included). The floor is measured on the vector P1 "
              "matrix M + K of the same mesh: one sparse matrix-vector product, one CG + Jacobi "
              "iteration and one Cholesky solve (PETSc's). Goal of issue 18: at most 5x the floor "
-             "at about 4k dofs and 3x at the reference size.")
+             "at about 4k dofs and 3x at the reference size. A step of these schemes performs "
+             "more than one solve (a damage and a mechanical solve, one linear solve per Newton "
+             "iteration, 4-40 CG iterations): the last two columns count, from PETSc's event "
+             "log, the triangular-solve pairs, SpMVs and factorisations of a step and the time "
+             "PETSc spends in its numerical kernels, and give the step over its own solves and "
+             "over its own arithmetic (benchmarks/README.md, issue 18, fifth session).")
     for label, table in tables:
         doc.para(f"**{label}**, from `{_shown(table)}`:")
         doc.markdown_table(table.read_text())
