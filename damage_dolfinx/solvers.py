@@ -16,6 +16,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
+from .callbacks import form_callbacks, relative_change
 
 
 class ConvergenceError(RuntimeError):
@@ -248,114 +249,10 @@ class SNESSolver:
         return its
 
 
-def form_callbacks(F, J, u, bcs, jacobian_split=None):
-    """(residual, jacobian, b, A) callbacks for SNESSolver from UFL forms F(u; w), J = dF/du.
-
-    The pattern of PROBLEMS.md / fenicsx-patterns section 2: the SNES iterate is copied into
-    ``u`` before assembly, Dirichlet rows are set to x - g so that the BC holds at convergence.
-    ``jacobian_split`` = (J_constant, J_varying) with J = J_constant + J_varying, J_constant
-    independent of u and of time (no Function in it): J_constant is assembled once (with the
-    Dirichlet identity rows), each Jacobian is a copy of it plus an assembly of J_varying
-    alone (issue 18: 2.3's normal compliance, a Gamma_C integral, instead of the whole domain).
-    """
-    F_form, J_form = compat.form(F), compat.form(J)
-    u_vec = compat.petsc_vec(u)
-
-    def residual(x, b):
-        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        x.copy(u_vec)
-        u.x.scatter_forward()
-        with b.localForm() as bl:
-            bl.set(0.0)
-        compat.assemble_vector(b, F_form)
-        compat.apply_lifting(b, J_form, bcs, x, -1.0)
-        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        compat.set_bc(b, bcs, x, -1.0)
-
-    def jacobian(x, A):
-        A.zeroEntries()
-        compat.assemble_matrix(A, J_form, bcs)
-        A.assemble()
-
-    A = compat.create_matrix(J_form)
-    if jacobian_split is not None:
-        jacobian = _split_jacobian(jacobian, J_form, *jacobian_split, A, bcs, u)
-    return residual, jacobian, compat.create_vector(F_form), A
-
-
-def constant_cell_jacobian(F, u):
-    """(J_constant, J_varying) for form_callbacks' ``jacobian_split``: the cell integrals of
-    J = dF/du when they contain no Function (F linear in u over the domain with fixed
-    coefficients, e.g. 2.3's B eps(u) + M_n), the other integrals (e.g. a Gamma_C contact
-    term) varying; None when the cell part depends on a Function or nothing varies."""
-    import ufl
-    from ufl.algorithms import expand_derivatives
-    J = expand_derivatives(ufl.derivative(F, u, ufl.TrialFunction(u.function_space)))
-    cell = [i for i in J.integrals() if i.integral_type() == "cell"]
-    other = [i for i in J.integrals() if i.integral_type() != "cell"]
-    if not cell or not other or any(isinstance(c, ufl.Coefficient) for c in
-                                    ufl.algorithms.extract_coefficients(ufl.Form(cell))):
-        return None
-    return ufl.Form(cell), ufl.Form(other)
-
-
-def _split_jacobian(full_jacobian, J_form, J_constant, J_varying, A, bcs, u):
-    """The Jacobian callback of form_callbacks' ``jacobian_split``: A = K + J_varying(u), K =
-    J_constant assembled once into the pattern of J. DOLFINx inserts (not adds) the Dirichlet
-    diagonal, so the second assembly leaves K's identity rows as they are; the split is
-    checked once against the assembly of J on a random u (relative Frobenius 1e-12)."""
-    import ufl
-    if any(isinstance(c, ufl.Coefficient) for c in ufl.algorithms.extract_coefficients(
-            J_constant)):
-        raise ValueError("J_constant of a split Jacobian depends on a Function")
-    K = compat.create_matrix(J_form)
-    full_jacobian(None, K)  # the pattern of an assembled J, the one A gets below
-    K.zeroEntries()
-    compat.assemble_matrix(K, compat.form(J_constant), bcs)
-    K.assemble()
-    varying = compat.form(J_varying)
-
-    def jacobian(x, A):
-        if not A.isAssembled():  # a new matrix (e.g. a lagged preconditioner): its pattern
-            full_jacobian(x, A)
-            return
-        K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        compat.assemble_matrix(A, varying, bcs)
-        A.assemble()
-
-    _check_split(jacobian, full_jacobian, A, u)
-    return jacobian
-
-
-def _check_split(jacobian, full_jacobian, A, u):
-    """The split Jacobian against the full assembly at a random u (u is restored)."""
-    saved = u.x.array.copy()
-    u.x.array[:] = np.random.default_rng(0).standard_normal(saved.shape)
-    u.x.scatter_forward()
-    full_jacobian(None, A)
-    full = A.duplicate(copy=True)
-    jacobian(None, A)
-    u.x.array[:] = saved
-    u.x.scatter_forward()
-    change = _relative_change(A, full)
-    full.destroy()
-    if not change <= 1e-12:
-        raise RuntimeError(f"split Jacobian differs from the assembled one ({change:.2e})")
-
-
 #: Newton defaults (semismooth Newton on max(., 0) terms); override with -<prefix>snes_* options
 NEWTON = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol": 1e-10,
           "snes_atol": 1e-10, "snes_stol": 1e-14, "snes_max_it": 50,
           "snes_divergence_tolerance": compat.PETSC_UNLIMITED, **DIRECT}
-
-
-def _relative_change(A, P) -> float:
-    """||A - P||_F / ||P||_F for matrices with the same sparsity."""
-    D = A.duplicate(copy=True)
-    D.axpy(-1.0, P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-    change = D.norm(PETSc.NormType.FROBENIUS) / max(P.norm(PETSc.NormType.FROBENIUS), 1e-300)
-    D.destroy()
-    return change
 
 
 class NonlinearSolver:
@@ -372,8 +269,8 @@ class NonlinearSolver:
     is refreshed (re-assembled as the current Jacobian) only when needed. With
     ``jacobian_key(x)`` (a local array on which the Jacobian alone depends, e.g. the stick set
     and eps), even the assembly is skipped while the key is unchanged. ``residual(x, b)``
-    replaces the assembly of F (same contract as the callback of :func:`form_callbacks`);
-    ``jacobian_split`` (:func:`constant_cell_jacobian`) assembles only the varying part of J.
+    replaces the assembly of F (same contract as the callback of :func:`callbacks.form_callbacks`);
+    ``jacobian_split`` (:func:`callbacks.constant_cell_jacobian`) assembles only the varying part of J.
     """
 
     def __init__(self, F, u, bcs, prefix: str, context: SolveContext, defaults=None,
@@ -410,7 +307,7 @@ class NonlinearSolver:
             krylov = self.ksp.getType() != "preonly"
             fresh = (self.factorizations == 0 or self._force_fresh
                      or (krylov and self.ksp.getIterationNumber() > self.refactor_after_its)
-                     or _relative_change(A, P) > self.jacobian_change_tol)
+                     or relative_change(A, P) > self.jacobian_change_tol)
             if fresh:
                 jacobian(x, P)
                 self.factorizations += 1

@@ -101,3 +101,42 @@ def test_example3_fading_memory_and_residual_stress(tmp_path):
     # stress (without memory both would vanish exactly)
     assert u1 > 0.2 * u0
     assert s1 > 1e-4 * s_half
+
+
+def test_split_jacobian_equals_assembly():
+    """The 2.3 Jacobian split (issue 18: constant cell part once, Gamma_C term per Newton step)
+    equals the full assembly, Dirichlet rows included, at a state in contact on part of Gamma_C;
+    a residual whose cell part depends on u is not split."""
+    import ufl
+    from damage_dolfinx.boundary import clamped
+    from damage_dolfinx.callbacks import constant_cell_jacobian, form_callbacks, relative_change
+    from damage_dolfinx.forms.viscoelastic_memory import displacement_residual
+    from damage_dolfinx.geometries import GAMMA_N
+    params = ModelParameters(E=100.0, nu=0.3, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,
+                             stop_at_zeta_star=False,
+                             extra={"c_nu": 1e3, "gap": 0.0, "memory_kernel": "constant"})
+    geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 6, 6,
+                    {GAMMA_D: side(1, 1.0), GAMMA_C: side(1, 0.0)})
+    s = ViscoelasticMemoryContact(ProblemData("split-test", geo, params, TimeGrid(1.0, 1.0)))
+    V = s.u.function_space
+    X = V.tabulate_dof_coordinates()
+    s.u.x.array.reshape(-1, 2)[:, 1] = -0.01 * np.sin(7.0 * X[:, 0])  # contact where < 0
+    ds = ufl.Measure("ds", domain=s.mesh, subdomain_data=geo.facet_tags)
+    F = displacement_residual(s.u, ufl.TestFunction(V), s.memory.M, 100.0, 0.3, 1e3, 0.0,
+                              ufl.FacetNormal(s.mesh), None, None, ds(GAMMA_N), ds(GAMMA_C))
+    J = ufl.derivative(F, s.u, ufl.TrialFunction(V))
+    bcs = [clamped(V, geo.facet_tags, GAMMA_D)]
+    split = constant_cell_jacobian(F, s.u)
+    assert split is not None
+    _, full, _, A = form_callbacks(F, J, s.u, bcs)
+    _, split_jacobian, _, B = form_callbacks(F, J, s.u, bcs, split)
+    full(None, A)
+    split_jacobian(None, B)
+    assert relative_change(B, A) < 1e-13
+    in_contact = A.duplicate(copy=True)
+    s.u.x.array[:] = 0.0
+    full(None, A)
+    assert relative_change(in_contact, A) > 1e-3  # the Gamma_C term was active above
+    w = ufl.TestFunction(V)
+    assert constant_cell_jacobian(ufl.inner(s.u, s.u) * ufl.inner(s.u, w) * ufl.dx
+                                  + ufl.inner(s.u, w) * ds(GAMMA_C), s.u) is None

@@ -30,7 +30,8 @@ from ..damage import DamageStep, source
 from ..forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
 from ..memory import MemoryKernel, MemoryTerm
 from ..parameters import InputError
-from ..solvers import NEWTON, NonlinearSolver, constant_cell_jacobian
+from ..callbacks import constant_cell_jacobian
+from ..solvers import NEWTON, NonlinearSolver
 from .base import ProblemData, TimeStepper
 
 
