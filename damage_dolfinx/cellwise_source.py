@@ -75,13 +75,18 @@ class CellwiseSource:
         self.e, self.phi = self.G.createVecLeft(), self.Q.createVecRight()
         self.q = self.Q.createVecLeft()
         self.k, self.p = float(k), p
+        # views of the strains and the source (stable: the Vecs own their arrays)
+        self._e = self.e.array.reshape(-1, self.components)
+        self._e_sq = np.empty_like(self._e)
+        self._phi, self._ones = self.phi.array, np.ones(self.components)
 
     def rhs(self, b: PETSc.Vec):
         """b = M zeta_old + k Q phi_c (owned entries; no ghost update is needed)."""
         p = self.p
         self.G.mult(self.u, self.e)
-        e, phi = self.e.array.reshape(-1, self.components), self.phi.array
-        np.einsum("ij,ij->i", e, e, out=phi)  # |eps_c|^2 (one pass; issue 18)
+        e, phi = self._e, self._phi
+        np.multiply(e, e, out=self._e_sq)  # |eps_c|^2: squares summed by a BLAS product
+        np.dot(self._e_sq, self._ones, out=phi)  # (14 -> 7 us on the wrench; issue 18)
         np.minimum(phi, p.q_star, out=phi)
         phi *= -0.5 * p.lam_u
         phi -= p.lam_w

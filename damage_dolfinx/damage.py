@@ -107,6 +107,8 @@ class DamageStep:
         self.fast = ObstacleFastPath(self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
                                      CHOLESKY_MAX_DOFS[V.mesh.topology.dim]) if enabled else None
         self.k, self._cellwise = k, None
+        self._atol_set, self._rtol, self._vecs = None, None, None
+        self._parallel = V.mesh.comm.size > 1
 
     def use_cellwise_source(self, u_old, p) -> bool:
         """Assemble l by sparse maps when phi_old = source(eps(u_old), zeta_old, p) is constant on
@@ -165,13 +167,18 @@ class DamageStep:
             self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
         # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
-        atol = max(self._atol, self.atol_rel * self.b.norm())
-        self.snes.snes.setTolerances(atol=atol)
-        if self.fast is not None and self.fast.step(
-                compat.petsc_vec(self.zeta_old), self.b, compat.petsc_vec(self.zeta), atol,
-                self.snes.snes.getTolerances()[0]):
-            self.zeta.x.scatter_forward()
-            return 0  # no SNES iteration
+        atol = max(self._atol, self.atol_rel * self.b.norm()) if self.atol_rel else self._atol
+        if atol != self._atol_set:  # issue 18: PETSc is told only when it changes
+            self.snes.snes.setTolerances(atol=atol)
+            self._atol_set = atol
+            self._rtol = self.snes.snes.getTolerances()[0]
+        if self.fast is not None:
+            if self._vecs is None:  # the PETSc views of zeta_old, zeta (stable)
+                self._vecs = (compat.petsc_vec(self.zeta_old), compat.petsc_vec(self.zeta))
+            if self.fast.step(self._vecs[0], self.b, self._vecs[1], atol, self._rtol):
+                if self._parallel:
+                    self.zeta.x.scatter_forward()
+                return 0  # no SNES iteration
         self.zeta.x.array[:] = self.zeta_old.x.array
         try:
             its = self.snes.solve(compat.petsc_vec(self.zeta))

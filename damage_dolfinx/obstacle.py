@@ -99,7 +99,10 @@ class ObstacleFastPath:
         self.snes_ksp = snes_ksp  # the CG copies its options prefix
         self.rstart = B.getOwnershipRange()[0]
         self.F, self.x1 = B.createVecLeft(), B.createVecRight()
-        self.y, self.rhs = B.createVecRight(), B.createVecLeft()
+        self.y = B.createVecRight()
+        # their value arrays (stable views: the Vecs own them; issue 18, fewer calls a step)
+        self._x1, self._y, self._f = self.x1.array, self.y.array, self.F.array
+        self._serial = self.comm.size == 1
         self._full = None  # solver of B (empty active set)
         self._key, self._cached = None, ()  # inactive mask and (KSP, rhs, y, B_II) of B_II
         self._reduced_ksp = None
@@ -114,10 +117,11 @@ class ObstacleFastPath:
                 "damage_vi_fast_fallbacks": self.fallbacks, "damage_vi_fast_skipped": self.skipped,
                 "damage_vi_fast_setups": self.setups}
 
-    def _allsum(self, values) -> np.ndarray:
+    def _allsum(self, values):
+        if self._serial:
+            return values
         values = np.asarray(values, dtype=float)
-        if self.comm.size > 1:
-            self.comm.Allreduce(MPI.IN_PLACE, values, op=MPI.SUM)
+        self.comm.Allreduce(MPI.IN_PLACE, values, op=MPI.SUM)
         return values
 
     @staticmethod
@@ -141,7 +145,7 @@ class ObstacleFastPath:
         B, F = self.B, self.F
         B.mult(z0, F)
         F.axpy(-1.0, l)
-        x0, f0 = z0.getArray(readonly=True), F.getArray(readonly=True)
+        x0, f0 = z0.getArray(readonly=True), self._f
         inactive = self._inactive(x0, f0)
         fnorm0 = float(np.sqrt(self._allsum([self._norm_sq(f0, inactive)])[0]))
         if fnorm0 <= atol:  # the SNES stops at iteration 0: z = z0
@@ -170,7 +174,7 @@ class ObstacleFastPath:
     def _accept(self, x0, l, z, inactive, atol, rtol, fnorm0) -> bool:
         """Step 2's update and projection, step 3's test; z = z1 if it passes."""
         B, F = self.B, self.F
-        x1, y = self.x1.array, self.y.array
+        x1, y = self._x1, self._y
         if inactive is None:  # x1 = x0 - y, the SNES's update (line search "basic")
             np.subtract(x0, y, out=x1)
             free = x1
@@ -184,7 +188,7 @@ class ObstacleFastPath:
             np.minimum(np.maximum(x1, self.lb, out=x1), self.ub, out=x1)
         B.mult(self.x1, F)
         F.axpy(-1.0, l)
-        f1 = F.getArray(readonly=True)
+        f1 = self._f
         fn1_sq, violating = self._allsum([self._norm_sq(f1, self._inactive(x1, f1)),
                                           float(violation > FEASIBILITY_TOL)])
         fnorm1 = float(np.sqrt(fn1_sq))
@@ -198,9 +202,8 @@ class ObstacleFastPath:
         if all_free:  # empty active set: B itself, its solver built once per run
             if self._full is None:
                 self._full = self._ksp(self.B, self.direct_full)
-            self.rhs.array[:] = f0
             ksp, y = self._full, self.y
-            ksp.solve(self.rhs, y)
+            ksp.solve(self.F, y)  # F holds F0 until _accept
         else:
             if inactive is None:  # empty here, not on another rank
                 inactive = np.ones(f0.shape, dtype=bool)

@@ -211,6 +211,9 @@ class VelocitySolver(LinearSolver):
             # homogeneous data: set_bc writes 0 into the Dirichlet rows (none on the wrench)
             self._bc_rows = np.unique(bc).astype(np.int32)
             self._rhs_vecs = (compat.petsc_vec(rhs[1]), compat.petsc_vec(rhs[2]))
+            # b's value array (serial: no ghosts; stable, b owns it). Written through this
+            # view, then by PETSc's axpy below, which also renews b's state (cached norms)
+            self._b_array = self.b.array
 
     def assemble_rhs(self):
         if self.rhs is None:
@@ -219,9 +222,8 @@ class VelocitySolver(LinearSolver):
         _, v_old, u_old, zeta_old, m_visc = self.rhs
         W = self.fast.product(zeta_old.x.array)                        # W(zeta_{n-1})
         b, tmp = self.b, self._tmp
-        with b.localForm() as bl:
-            bl.set(0.0)
-        compat.assemble_vector(b, self.l_boundary)                      # contact + load
+        self._b_array.fill(0.0)
+        compat.assemble_vector_array(self._b_array, self.l_boundary)   # contact + load
         v_vec, u_vec = self._rhs_vecs
         self.M.mult(v_vec, tmp)                                         # rho/k M v_{n-1}
         b.axpy(1.0, tmp)
