@@ -28,6 +28,7 @@ from ..boundary import clamped
 from ..constitutive import eps, von_mises
 from ..damage import DamageStep, source
 from ..forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
+from ..cellwise_stress import MemoryIntegrand
 from ..memory import MemoryKernel, MemoryTerm
 from ..parameters import InputError
 from ..callbacks import constant_cell_jacobian
@@ -78,6 +79,15 @@ class ViscoelasticMemoryContact(TimeStepper):
         self.memory = MemoryTerm(msh, kernel, k, x.get("memory_mode", "auto"))
         self._g_expr = compat.expression(
             memory_integrand(self.u, self.zeta, p.E, p.nu, p.L_trunc), self.memory.space)
+        # issue 18: g by the cell stress map S u (cellwise_stress.py, checked against the
+        # interpolation at construction; P1 u on simplices): 0.9 ms of 3.8 per step at 4k dofs
+        self._g_map = None
+        if compat.element_degree(V) == 1:
+            try:
+                self._g_map = MemoryIntegrand(self.memory.g, self.u, self.zeta, p.E, p.nu,
+                                              p.L_trunc, self._g_expr)
+            except RuntimeError:  # the map differs from the interpolation: keep the latter
+                pass
 
         # (2.137): nonlinear displacement step
         tags = data.geometry.facet_tags
@@ -128,7 +138,7 @@ class ViscoelasticMemoryContact(TimeStepper):
         return {"mech_its": its}
 
     def _advance(self) -> dict:
-        self._timed("memory", self.memory.update, self._g_expr)  # uses u_{n-1}, zeta_{n-1}
+        self._timed("memory", self.memory.update, self._g_map or self._g_expr)  # u_{n-1}, zeta_{n-1}
         self.zeta_old.x.array[:] = self.zeta.x.array
         damage_its = self._timed("damage", self.damage.solve)
         mech_its = self._timed("mech", self.mech.solve)
