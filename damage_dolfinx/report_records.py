@@ -106,7 +106,7 @@ def _step_floor(doc):
     folder = REFERENCE / "step_floor"
     # the newest record of each size first: this session's damage fast path (``_vi_after``)
     tables = [(label, next((folder / f"step_floor_{tag}{suffix}.md"
-                            for suffix in ("_s9", "_s8", "_vi_after", "_after")
+                            for suffix in ("_s10", "_s9", "_s8", "_vi_after", "_after")
                             if (folder / f"step_floor_{tag}{suffix}.md").is_file()), None))
               for label, tag in (("about 4k dofs (n = 45)", "n45"),
                                  ("reference size (n = 255, 131k dofs)", "n255"))]
@@ -123,7 +123,7 @@ def _step_floor(doc):
              "iteration, 4-40 CG iterations): the last two columns count, from PETSc's event "
              "log, the triangular-solve pairs, SpMVs and factorisations of a step and the time "
              "PETSc spends in its numerical kernels, and give the step over its own solves and "
-             "over its own arithmetic (benchmarks/README.md, issue 18, fifth session).")
+             "over its own arithmetic (benchmarks/README.md, issue 18, fifth and sixth sessions).")
     for label, table in tables:
         doc.para(f"**{label}**, from `{_shown(table)}`:")
         doc.markdown_table(table.read_text())
