@@ -26,7 +26,8 @@ from .constitutive import eps
 CHECK_RTOL = 1e-12
 
 
-def _matrix(a):
+def assembled_matrix(a) -> PETSc.Mat:
+    """The assembled matrix of the bilinear UFL form ``a`` (no boundary conditions)."""
     form = compat.form(a)
     A = compat.create_matrix(form)
     compat.assemble_matrix(A, form, [])
@@ -45,9 +46,9 @@ class CellwiseSource:
         d = msh.topology.dim
         Z, T = zeta_old.function_space, compat.tensor_dg0(msh)
         xi, tau = ufl.TestFunction(Z), ufl.TestFunction(T)
-        self.M = _matrix(ufl.TrialFunction(Z) * xi * ufl.dx)
-        G = _matrix(ufl.inner(eps(ufl.TrialFunction(u_old.function_space)), tau) * ufl.dx)
-        volume = _matrix(ufl.inner(ufl.TrialFunction(T), tau) * ufl.dx).getDiagonal()
+        self.M = assembled_matrix(ufl.TrialFunction(Z) * xi * ufl.dx)
+        G = assembled_matrix(ufl.inner(eps(ufl.TrialFunction(u_old.function_space)), tau) * ufl.dx)
+        volume = assembled_matrix(ufl.inner(ufl.TrialFunction(T), tau) * ufl.dx).getDiagonal()
         volume.reciprocal()
         G.diagonalScale(L=volume)  # rows / |c|: the cell strain itself
         # the independent strain components per cell, off-diagonal ones times sqrt(2), so that
@@ -65,7 +66,7 @@ class CellwiseSource:
         weight = self.G.createVecLeft()
         weight.array.reshape(-1, len(pairs))[:] = [1.0 if i == j else np.sqrt(2.0) for i, j in pairs]
         self.G.diagonalScale(L=weight)
-        Q = _matrix(ufl.TrialFunction(T)[0, 0] * xi * ufl.dx)
+        Q = assembled_matrix(ufl.TrialFunction(T)[0, 0] * xi * ufl.dx)
         z_rows = PETSc.IS().createStride(Q.getOwnershipRange()[1] - Q.getOwnershipRange()[0],
                                          Q.getOwnershipRange()[0], 1, comm=comm)
         first = PETSc.IS().createGeneral(blocks.astype(PETSc.IntType), comm=comm)

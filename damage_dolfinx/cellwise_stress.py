@@ -23,6 +23,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from . import compat
+from .cellwise_source import assembled_matrix
 from .constitutive import B, eps
 
 #: largest relative difference to the interpolation accepted by the set-up checks (round-off)
@@ -33,15 +34,8 @@ def stress_matrix(V, E, nu) -> PETSc.Mat:
     """S: u (P1 vector) -> B eps(u) on each cell, rows in the DG0 tensor dof layout."""
     T = compat.tensor_dg0(V.mesh)
     tau = ufl.TestFunction(T)
-    form = compat.form(ufl.inner(B(eps(ufl.TrialFunction(V)), E, nu), tau) * ufl.dx)
-    S = compat.create_matrix(form)
-    compat.assemble_matrix(S, form, [])
-    S.assemble()
-    mass = compat.form(ufl.inner(ufl.TrialFunction(T), tau) * ufl.dx)
-    volume = compat.create_matrix(mass)
-    compat.assemble_matrix(volume, mass, [])
-    volume.assemble()
-    inv = volume.getDiagonal()
+    S = assembled_matrix(ufl.inner(B(eps(ufl.TrialFunction(V)), E, nu), tau) * ufl.dx)
+    inv = assembled_matrix(ufl.inner(ufl.TrialFunction(T), tau) * ufl.dx).getDiagonal()
     inv.reciprocal()
     S.diagonalScale(L=inv)  # rows / |c|: the cell value itself
     return S
