@@ -41,9 +41,23 @@ def stress_matrix(V, E, nu) -> PETSc.Mat:
     return S
 
 
-def _relative(a: np.ndarray, b: np.ndarray, comm) -> float:
-    diff = comm.allreduce(float(np.abs(a - b).max(initial=0.0)), op=MPI.MAX)
-    scale = comm.allreduce(float(np.abs(b).max(initial=0.0)), op=MPI.MAX)
+def _check_against(target, expression, apply, randomize, funcs) -> float:
+    """Largest relative difference, over the owned values of ``target``, between ``apply()``
+    and compat.interpolate(target, expression) after ``randomize()`` has set a random state;
+    the values of ``funcs`` (everything randomize or apply writes) are restored."""
+    saved = [f.x.array.copy() for f in funcs]
+    randomize()
+    compat.interpolate(target, expression)
+    V = target.function_space
+    owned = V.dofmap.index_map.size_local * V.dofmap.index_map_bs
+    expected = target.x.array[:owned].copy()
+    apply()
+    comm = V.mesh.comm
+    diff = comm.allreduce(float(np.abs(target.x.array[:owned] - expected).max(initial=0.0)),
+                          op=MPI.MAX)
+    scale = comm.allreduce(float(np.abs(expected).max(initial=0.0)), op=MPI.MAX)
+    for f, values in zip(funcs, saved):
+        f.x.array[:] = values
     return diff / max(scale, 1e-300)
 
 
@@ -55,7 +69,7 @@ class StressUpdate:
         self.S = stress_matrix(w.function_space, E, nu)
         self.w = compat.petsc_vec(w)
         self.Sw = self.S.createVecLeft()
-        self.owned = self.Sw.getLocalSize()
+        self.owned = self.Sw.getLocalSize()  # owned DG0 tensor values
         self.check = self._check(w, expression)
         if not self.check <= CHECK_RTOL:
             raise RuntimeError(f"cell stress map differs from the interpolation by {self.check:.1e}")
@@ -70,21 +84,14 @@ class StressUpdate:
         self.sigma.x.scatter_forward()
 
     def _check(self, w, expression) -> float:
-        """The map against compat.interpolate of ``expression`` on random w, sigma_old, Ghat
-        (all restored)."""
-        rng = np.random.default_rng(0)
-        funcs = (w, self.sigma_old, self.G_hat, self.sigma)
-        saved = [f.x.array.copy() for f in funcs]
-        for f in funcs[:3]:
-            f.x.array[:] = rng.standard_normal(f.x.array.size)
-            f.x.scatter_forward()
-        compat.interpolate(self.sigma, expression)
-        expected = self.sigma.x.array[:self.owned].copy()
-        self()
-        err = _relative(self.sigma.x.array[:self.owned], expected, self.sigma.function_space.mesh.comm)
-        for f, values in zip(funcs, saved):
-            f.x.array[:] = values
-        return err
+        """The map against the interpolation on random w, sigma_old, Ghat (all restored)."""
+        def randomize():
+            rng = np.random.default_rng(0)
+            for f in (w, self.sigma_old, self.G_hat):
+                f.x.array[:] = rng.standard_normal(f.x.array.size)
+                f.x.scatter_forward()
+        return _check_against(self.sigma, expression, self, randomize,
+                              (w, self.sigma_old, self.G_hat, self.sigma))
 
 
 class MemoryIntegrand:
@@ -130,24 +137,19 @@ class MemoryIntegrand:
         self.g.x.scatter_forward()
 
     def _check(self, expression) -> float:
-        rng = np.random.default_rng(0)
-        funcs = (self.u_fn, self.zeta, self.g)
-        saved = [f.x.array.copy() for f in funcs]
-        comm = self.g.function_space.mesh.comm
-        self.u_fn.x.array[:] = rng.standard_normal(self.u_fn.x.array.size)
-        self.u_fn.x.scatter_forward()
-        if self.L is not None:  # the largest stress component at 2 L: Phi_L is checked too
-            self.S.mult(self.u, self.Su)
-            top = comm.allreduce(float(np.abs(self.Su.array).max(initial=0.0)), op=MPI.MAX)
-            self.u_fn.x.array[:] *= 2.0 * self.L / max(top, 1e-300)
-        self.zeta.x.array[:] = rng.uniform(0.01, 1.0, self.zeta.x.array.size)
-        for f in funcs[:2]:
-            f.x.scatter_forward()
-        compat.interpolate(self.g, expression)
-        owned = self.g.function_space.dofmap.index_map.size_local * self.comps
-        expected = self.g.x.array[:owned].copy()
-        self()
-        err = _relative(self.g.x.array[:owned], expected, self.g.function_space.mesh.comm)
-        for f, values in zip(funcs, saved):
-            f.x.array[:] = values
-        return err
+        """The map against the interpolation on random u and zeta, with the largest stress
+        component at 2 L so that Phi_L clips (all restored)."""
+        def randomize():
+            rng = np.random.default_rng(0)
+            self.u_fn.x.array[:] = rng.standard_normal(self.u_fn.x.array.size)
+            self.u_fn.x.scatter_forward()
+            if self.L is not None:
+                self.S.mult(self.u, self.Su)
+                top = self.g.function_space.mesh.comm.allreduce(
+                    float(np.abs(self.Su.array).max(initial=0.0)), op=MPI.MAX)
+                self.u_fn.x.array[:] *= 2.0 * self.L / max(top, 1e-300)
+            self.zeta.x.array[:] = rng.uniform(0.01, 1.0, self.zeta.x.array.size)
+            for f in (self.u_fn, self.zeta):
+                f.x.scatter_forward()
+        return _check_against(self.g, expression, self, randomize,
+                              (self.u_fn, self.zeta, self.g))
