@@ -45,7 +45,7 @@ def parse():
 
 
 def run(args, comm):
-    from damage_dolfinx import runner
+    from damage_dolfinx.runtime import runner
     from damage_dolfinx.cli import _overrides
     return runner.run("2.1-ex3", Path(args.out) / "run", h=args.h, k=args.k, T=args.T,
                       overrides=_overrides(args.set, reading=args.reading), progress=True,
@@ -62,7 +62,7 @@ def read_history(path):
 def plot_curve(P, d, summary, path):
     """Figure 2.7 (figstyle): our curve, the thesis's two failure loads as lines named in the
     legend (no text over the curve), the collapse point."""
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     pyplot = figstyle.plt()
     fig, ax = pyplot.subplots(figsize=(6.4, 4.2))
     ax.plot(d, P, "o-", ms=3, label="damage model (this run)")
@@ -82,7 +82,7 @@ def plot_curve(P, d, summary, path):
 
 def plot_section_damage(summary, path):
     import numpy as np
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     pyplot = figstyle.plt()
     D = np.asarray(summary["failure_section_damage"])
     n = D.size - 1

@@ -65,7 +65,7 @@ def cases(quick):
 
 def collapse(h, k, overrides, geometry, comm, T=0.3):
     """Step example 2.1-ex3 (in memory) until collapse; returns a result row."""
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     from damage_dolfinx.geometries.bridge import arch_bridge
     ex = examples.get("2.1-ex3")
     if geometry:
@@ -133,7 +133,7 @@ def write_tables(rows, out: Path):
 
 
 def plot(rows, path):
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     fig, axes = figstyle.plt().subplots(1, 3, figsize=(13, 3.8))
     for ax, (study, key, label) in zip(axes, (("mesh", "h", "mesh size $h$ [m]"),
                                               ("time step", "k", "time step $k$ [s]"),

@@ -36,7 +36,7 @@ def _amg_options() -> list:
     """scalable.MECH_AMG as command-line options (below the size threshold the code defaults
     are the direct ones, so every AMG option is given explicitly)."""
     sys.path.insert(0, str(ROOT))
-    from damage_dolfinx.scalable import MECH_AMG
+    from damage_dolfinx.numerics.scalable import MECH_AMG
     return [x for key, value in MECH_AMG.items() for x in (f"-mech_{key}", str(value))]
 
 

@@ -13,7 +13,8 @@ import argparse
 
 from mpi4py import MPI
 
-from damage_dolfinx import convergence, examples
+from damage_dolfinx.studies import convergence
+from damage_dolfinx.catalogue import examples
 
 parser = argparse.ArgumentParser()
 parser.add_argument("id")

@@ -11,7 +11,7 @@ OUT/index.json lists commands, rates and wall times.
 import argparse
 from pathlib import Path
 
-from damage_dolfinx import reproduce
+from damage_dolfinx.report import reproduce
 
 p = argparse.ArgumentParser()
 p.add_argument("--quick", action="store_true", help="three coarse meshes, small reference")

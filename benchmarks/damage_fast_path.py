@@ -25,7 +25,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx import checkpoint, examples
+from damage_dolfinx.runtime import checkpoint
+from damage_dolfinx.catalogue import examples
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import profile_rows, write_record  # noqa: E402

@@ -22,7 +22,9 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from damage_dolfinx import examples, post, runner
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.viz import post
+from damage_dolfinx.runtime import runner
 
 EXAMPLE = "3.3-ex2"
 FIGURES = {"a": "figure_3_17.png", "b": "figure_3_18.png"}
@@ -44,7 +46,7 @@ out = Path(args.out)
 def default_k(n):
     """The largest k = 0.5/N <= 0.8 k_max (stability.py on the n x n mesh, as in the run);
     T/N if T is not a multiple of 0.5 s."""
-    from damage_dolfinx.stability import SAFETY
+    from damage_dolfinx.numerics.stability import SAFETY
     probe = examples.get(EXAMPLE).build(comm, n=n, k=args.T / 1e6, T=args.T)
     k_max = probe.stability["k_max"]
     base = 0.5 if abs(args.T / 0.5 - round(args.T / 0.5)) < 1e-9 else args.T

@@ -320,7 +320,7 @@ def case_checkpoint_files(t, out):
 #: the command line with the writes of files named ARGV[1]* failing with EIO from the ARGV[2]-th
 #: on (a failing disk; the same injection as tests/test_faults.py)
 EIO = """import builtins, errno, os, sys
-from damage_dolfinx import atomic, io
+from damage_dolfinx.runtime import atomic, io
 name, after, count = sys.argv[1], int(sys.argv[2]), [0]
 class Failing:
     def __init__(self, f): self._f = f

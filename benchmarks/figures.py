@@ -13,7 +13,8 @@ Thesis pairs drawn by different runs or at different times (2.4/2.5, 2.17, 2.20,
 import argparse
 from pathlib import Path
 
-from damage_dolfinx import figstyle, reproduce
+from damage_dolfinx.viz import figstyle
+from damage_dolfinx.report import reproduce
 
 #: thesis figures whose two files share one stress (or strain) colour scale
 PAIRS = [("figure_2_4.png", "figure_2_5.png"), ("figure_2_17_t0.png", "figure_2_17_t2.png"),

@@ -21,9 +21,11 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from damage_dolfinx import compat, examples, runner
-from damage_dolfinx.constitutive import eps
-from damage_dolfinx.solvers import ConvergenceError
+from damage_dolfinx import compat
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.runtime import runner
+from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.numerics.solvers import ConvergenceError
 
 SOLVERS = ("newton", "uzawa", "penalty-duality")
 parser = argparse.ArgumentParser()

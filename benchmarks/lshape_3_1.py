@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx import examples, post
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.viz import post
 
 COMM = MPI.COMM_WORLD
 
@@ -56,7 +57,7 @@ def side_by_side(steppers, field_name, amplification, path, title, label, mesh_o
     outline = post.gather_cells(None, steppers[0].zeta, 0.0)
     if COMM.rank != 0:
         return
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     names = ("undamaged ($\\zeta$ = 1)", "damaged")
     data = [{"xy": xy, "values": vals, "name": field_name, "label": label, "title": name}
             for (xy, vals), name in zip(panels, names)]

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx import runner
+from damage_dolfinx.runtime import runner
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--n", type=int, default=64)

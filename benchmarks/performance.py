@@ -27,7 +27,7 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 
 
 def measure(example, n, np_, steps, out):
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     k = examples.get(example).k
     cmd = [sys.executable, "-m", "damage_dolfinx.cli", "run", example, "--n", str(n),
            "--T", f"{steps * k:.12g}", "--k", f"{k:.12g}", "--no-figures", "--quiet",

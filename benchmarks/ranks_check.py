@@ -28,7 +28,7 @@ TOL = 1e-8
 
 
 def _options(ex, steps):
-    from damage_dolfinx.reproduce import _quick_options
+    from damage_dolfinx.report.reproduce import _quick_options
     opts = _quick_options(ex)
     k = float(opts[opts.index("--k") + 1]) if "--k" in opts else ex.k
     if "--T" in opts:
@@ -44,7 +44,7 @@ def main(argv=None):
     ap.add_argument("--steps", type=int, default=10)
     ap.add_argument("--only", nargs="+")
     args = ap.parse_args(argv)
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
     rows = []

@@ -14,7 +14,7 @@ import shutil
 import subprocess
 import tempfile
 
-from damage_dolfinx import report
+from damage_dolfinx.report import build
 
 p = argparse.ArgumentParser()
 p.add_argument("--results", default="results")

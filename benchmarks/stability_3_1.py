@@ -22,8 +22,10 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from damage_dolfinx import compat, examples, stability
-from damage_dolfinx.boundary import clamped
+from damage_dolfinx import compat
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.numerics import stability
+from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
 from damage_dolfinx.parameters import InputError

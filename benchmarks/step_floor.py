@@ -33,8 +33,9 @@ import ufl
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from damage_dolfinx import compat, examples
-from damage_dolfinx.constitutive import eps
+from damage_dolfinx import compat
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.numerics.constitutive import eps
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import best, profile_rows, write_record  # noqa: E402

@@ -33,7 +33,7 @@ def profile():
     from mpi4py import MPI
 
     import damage_dolfinx
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     s = examples.get("3.2-ex1").build(MPI.COMM_WORLD, n=args.n, k=args.k,
                                       T=args.k * args.steps)
     s.initialize()

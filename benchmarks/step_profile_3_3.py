@@ -28,8 +28,9 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from damage_dolfinx import compat, examples
-from damage_dolfinx.problems import fully_damageable_3_3 as fd
+from damage_dolfinx import compat
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.models import fully_damageable_3_3 as fd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import best  # noqa: E402

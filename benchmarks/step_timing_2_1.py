@@ -18,8 +18,9 @@ from pathlib import Path
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from damage_dolfinx import examples, io
-from damage_dolfinx.problems.elastic_2_1 import ElasticDamage
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.runtime import io
+from damage_dolfinx.models.elastic_2_1 import ElasticDamage
 
 parser = argparse.ArgumentParser()
 parser.add_argument("--n", type=int, default=160)

@@ -52,7 +52,7 @@ def parse():
 
 
 def run_case(case, h, out, comm):
-    from damage_dolfinx import runner
+    from damage_dolfinx.runtime import runner
     from damage_dolfinx.catalogue import bridge
     ex_id, geometry, _ = CASES[case]
     saved = dict(bridge.VAULT_GEOMETRY)
@@ -69,7 +69,7 @@ def run_case(case, h, out, comm):
 
 def stiffness(comm):
     """u_y of the load strip under self weight (t = 0): 3-D / 2-D at three h, two nu."""
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     from damage_dolfinx.geometries.vault import barrel_vault
     rows = []
 
@@ -125,7 +125,7 @@ def rotation_at(summary, sections):
 
 
 def plot_sections(records, path, h_mesh):
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     pyplot = figstyle.plt()
     fig, ax = pyplot.subplots(figsize=(7.2, 3.8))
     for case, rec in records.items():
@@ -188,7 +188,7 @@ def main():
     stiff = None if args.no_stiffness or args.plot_only else stiffness(comm)
     if comm.rank != 0:
         return
-    from damage_dolfinx import hinge_lines
+    from damage_dolfinx.viz import hinge_lines
     ref.mkdir(parents=True, exist_ok=True)
     cases = {c: case_record(s) for c, s in summaries.items()}
     if "arch2d" in summaries:  # do the 3-D cases rotate where the 2-D arch hinges?
@@ -228,8 +228,8 @@ def main():
 
 def _plot_curves(first_csv, first_fail, first_label, others, path, h_mesh):
     """All cases on one load-displacement plot (hinge_lines.plot_load_displacement, extended)."""
-    from damage_dolfinx import figstyle
-    from damage_dolfinx.hinge_lines import read_curve
+    from damage_dolfinx.viz import figstyle
+    from damage_dolfinx.viz.hinge_lines import read_curve
     pyplot = figstyle.plt()
     fig, ax = pyplot.subplots(figsize=(6.8, 4.4))
     for csv_path, fail, label in [(first_csv, first_fail, first_label)] + others:

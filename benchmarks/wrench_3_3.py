@@ -21,7 +21,9 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx import examples, post, runner
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.viz import post
+from damage_dolfinx.runtime import runner
 
 EXAMPLE = "3.3-ex3"
 
@@ -40,7 +42,7 @@ out = Path(args.out)
 
 def default_k(h, T):
     """The largest k = T/N <= 0.8 k_max (stability.py on the mesh of size h)."""
-    from damage_dolfinx.stability import SAFETY
+    from damage_dolfinx.numerics.stability import SAFETY
     probe = examples.get(EXAMPLE).build(comm, h=h, k=T / 1e6, T=T)
     k_max = probe.stability["k_max"]
     return T / math.ceil(T / (SAFETY * k_max)), k_max
@@ -49,7 +51,7 @@ def default_k(h, T):
 def plot_deformed_mesh(stepper, amplification, path):
     """Deformed wire mesh x amplification over the undeformed outline (Figure 3.20, drawn by
     figstyle, the factor rounded to 1-2-5 x 10^k if it is not); collective."""
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     amplification = figstyle.drawn_amplification(amplification)
     deformed = post.gather_cells(stepper.u, stepper.zeta, amplification)
     initial = post.gather_cells(None, stepper.zeta, 0.0)
@@ -62,7 +64,7 @@ def plot_deformed_mesh(stepper, amplification, path):
 
 
 def plot_penetration(history, path):
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     pyplot = figstyle.plt()
     with open(history) as f:
         rows = list(csv.DictReader(f))

@@ -29,6 +29,11 @@ def _parser():
                         help="override a model parameter, e.g. --set kappa=0.01 (repeatable)")
         sp.add_argument("--out", required=True, help="output folder")
         sp.add_argument("--quiet", action="store_true", help="no progress lines")
+        sp.add_argument("--allow-unstable", action="store_true",
+                        help="run a time step above the scheme's stability limit k_max (a "
+                             "warning instead of a refusal), to study instability on purpose")
+        sp.add_argument("--allow-long", action="store_true",
+                        help="allow more than 10^7 time steps")
         sp.add_argument("--friction-solver", choices=("newton", "uzawa", "penalty-duality"),
                         help="Tresca solver of Sections 2.2/2.4/3.2 (same as --set friction_solver=...)")
         sp.add_argument("--friction-law", choices=("tresca", "coulomb"),
@@ -98,9 +103,13 @@ def _is_option(tok):
         return True
 
 
-def _overrides(pairs, friction_solver=None, friction_law=None, reading=None):
-    from .parameters import InputError
+def _overrides(pairs, friction_solver=None, friction_law=None, reading=None, args=None):
+    from damage_dolfinx.parameters import InputError
     out = {} if friction_solver is None else {"friction_solver": friction_solver}
+    if args is not None and args.allow_unstable:
+        out["stability_check"] = "warn"
+    if args is not None and args.allow_long:
+        out["allow_long"] = True
     if friction_law is not None:
         out["friction_law"] = friction_law
     if reading is not None:
@@ -116,7 +125,7 @@ def _overrides(pairs, friction_solver=None, friction_law=None, reading=None):
 def _check_finite(args):
     """Every number on the command line is finite (argparse's float() accepts 'inf' and 'nan')."""
     import math
-    from .parameters import InputError
+    from damage_dolfinx.parameters import InputError
     for name, value in vars(args).items():
         for v in value if isinstance(value, list) else [value]:
             if isinstance(v, float) and not math.isfinite(v):
@@ -126,27 +135,27 @@ def _check_finite(args):
 def main(argv=None):
     comm = MPI.COMM_WORLD
     args, extra = _parser().parse_known_args(argv)
-    from .parameters import InputError
-    from .solvers import ConvergenceError
-    from .io import OutputError
-    from .runner import RunInterrupted
+    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.numerics.solvers import ConvergenceError
+    from damage_dolfinx.runtime.io import OutputError
+    from damage_dolfinx.runtime.runner import RunInterrupted
     try:
         leftovers = _petsc_options(extra)
         if leftovers:
             raise InputError(f"unrecognised arguments: {' '.join(leftovers)}")
         _check_finite(args)
         if args.command == "list":
-            from . import examples
+            from damage_dolfinx.catalogue import examples
             if comm.rank == 0:
                 for ex in examples.catalogue().values():
                     reading = f" (reading: {ex.reading})" if ex.readings else ""
                     print(f"{ex.id:10s} [Section {ex.section}] {ex.title}{reading}")
             return 0
         if args.command == "run":
-            from . import runner
+            from damage_dolfinx.runtime import runner
             runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
                        overrides=_overrides(args.set, args.friction_solver, args.friction_law,
-                                                 args.reading),
+                                                 args.reading, args),
                        mesh_file=args.mesh,
                        write_every=args.write_every, progress=not args.quiet,
                        figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
@@ -154,11 +163,11 @@ def main(argv=None):
                        overwrite=args.overwrite, history_every=args.history_every)
             return 0
         if args.command == "converge":
-            from . import convergence
+            from damage_dolfinx.studies import convergence
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
                               ns=args.n, ks=args.k, T=args.T,
                               overrides=_overrides(args.set, args.friction_solver,
-                                                   args.friction_law, args.reading),
+                                                   args.friction_law, args.reading, args),
                               progress=not args.quiet,
                               reference_ranks={"1": 1, "all": "all", None: None}[
                                   args.reference_ranks])
@@ -174,7 +183,7 @@ def main(argv=None):
     except OutputError as exc:
         if comm.rank == 0:
             print(f"damage-dolfinx: output error: {exc}", file=sys.stderr, flush=True)
-        from .io import FAILED_HDF5_FILES
+        from damage_dolfinx.runtime.io import FAILED_HDF5_FILES
         if FAILED_HDF5_FILES:  # HDF5 would crash shutting down the failed file
             sys.stdout.flush()
             comm.Barrier()
@@ -182,7 +191,7 @@ def main(argv=None):
         return 4
     except RunInterrupted as exc:
         import signal
-        from .runner import STOP_SIGNALS
+        from damage_dolfinx.runtime.runner import STOP_SIGNALS
         for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out
             signal.signal(s, signal.SIG_IGN)
         if comm.rank == 0:

@@ -262,6 +262,15 @@ def locate_entities(msh, dim, marker):
     return dmesh.locate_entities(msh, dim, marker)
 
 
+def cell_diameters(msh, cells):
+    """Diameters of the given local cells (``cpp.mesh.h`` up to 0.7, ``Mesh.h`` later)."""
+    from dolfinx import cpp
+    cells = np.asarray(cells, dtype=np.int32)
+    if hasattr(cpp.mesh, "h"):
+        return np.asarray(cpp.mesh.h(msh, msh.topology.dim, cells))
+    return np.asarray(msh.h(msh.topology.dim, cells))
+
+
 def meshtags(msh, dim, entities, values):
     order = np.argsort(entities)
     return dmesh.meshtags(msh, dim, np.asarray(entities, np.int32)[order],
@@ -316,14 +325,32 @@ def xdmf_file(comm, path, mode):
     return XDMFFile(comm, str(path), mode)
 
 
-def read_msh(comm, path, rank=0, gdim=2):
-    """.msh file -> (mesh, cell_tags, facet_tags)."""
+def read_msh(comm, path, rank=0, gdim=None, check=None):
+    """.msh file -> (mesh, cell_tags, facet_tags) on every version: gmsh reads the file on
+    ``rank`` into a model of its own, which ``model_to_mesh`` distributes (DOLFINx 0.5.2's
+    ``gmshio.read_from_msh`` returns an undefined name, so it is not used anywhere). ``gdim``:
+    the geometric dimension (None: the model's dimension). ``check(gmsh) -> str | None`` looks at
+    the model on ``rank`` before anything is distributed; a message (or gmsh's own error while
+    reading) raises ValueError on every rank."""
+    from damage_dolfinx.geometries import gmsh_session
+    gmsh = gmsh_session()
+    dim, error = None, None
+    if comm.rank == rank:
+        gmsh.model.add("damage_dolfinx_read")
+        try:
+            gmsh.merge(str(path))
+            dim = gmsh.model.getDimension()
+            error = check(gmsh) if check else None
+        except Exception as exc:  # gmsh raises a bare Exception with its own message
+            error = f"gmsh cannot read it ({str(exc).strip() or type(exc).__name__})"
+    dim, error = comm.bcast((dim, error), root=rank)
     try:
-        from dolfinx.io import gmshio
-    except ImportError:
-        from dolfinx.io import gmsh as gmshio
-    out = gmshio.read_from_msh(path, comm, rank, gdim=gdim)
-    return (out.mesh, out.cell_tags, out.facet_tags) if hasattr(out, "mesh") else out
+        if error:
+            raise ValueError(error)
+        return model_to_mesh(gmsh.model, comm, rank, gdim=gdim or dim)
+    finally:
+        if comm.rank == rank:
+            gmsh.model.remove()
 
 
 def bc_dofs(bc):

@@ -9,11 +9,11 @@ linear system with a fixed matrix (the thesis' (3.64) is this equation times k, 
 """
 import ufl
 
-from damage_dolfinx.constitutive import eps
-from damage_dolfinx.contact import normal_compliance_pressure
+from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.numerics.contact import normal_compliance_pressure
 
-from .elastic_damage import load
-from .kelvin_voigt import damaged_elastic_stress, viscous_stress
+from damage_dolfinx.forms.elastic_damage import load
+from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, viscous_stress
 
 #: quadrature degree of the truncated (Phi_L) and positive-part (contact) terms (G38)
 NONLINEAR_DEGREE = 2

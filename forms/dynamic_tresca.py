@@ -9,10 +9,10 @@ second-kind VI a(v, w - v) + j(w) - j(v) >= l(w - v) that ``friction.FrictionPro
 """
 import ufl
 
-from damage_dolfinx.constitutive import B, Phi_L, eps, eta_star
+from damage_dolfinx.numerics.constitutive import B, Phi_L, eps, eta_star
 
-from .elastic_damage import load
-from .kelvin_voigt import viscous_stress
+from damage_dolfinx.forms.elastic_damage import load
+from damage_dolfinx.forms.kelvin_voigt import viscous_stress
 
 
 def elastic_stress(u, zeta, E, nu, L_trunc, zeta_star):

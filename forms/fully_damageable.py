@@ -15,10 +15,10 @@ only; the step is then nonlinear (semismooth in the contact term) and returned a
 """
 import ufl
 
-from damage_dolfinx.constitutive import B, Phi_L, eps, eta_star
-from damage_dolfinx.contact import positive_part
+from damage_dolfinx.numerics.constitutive import B, Phi_L, eps, eta_star
+from damage_dolfinx.numerics.contact import positive_part
 
-from .elastic_damage import load
+from damage_dolfinx.forms.elastic_damage import load
 
 #: quadrature degree of the truncated (Phi_L, eta_*) and positive-part (contact) terms (G38)
 NONLINEAR_DEGREE = 2

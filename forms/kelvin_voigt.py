@@ -6,9 +6,9 @@ A = B / m_visc (viscosity, implicit), damaged truncated elasticity explicit (2.1
 """
 import ufl
 
-from damage_dolfinx.constitutive import B, Phi_L, eps
+from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
 
-from .elastic_damage import load
+from damage_dolfinx.forms.elastic_damage import load
 
 
 def viscous_stress(v, E, nu, m_visc):

@@ -7,10 +7,10 @@ g(eps, zeta) = zeta Phi_L(B eps) (memory.py).
 """
 import ufl
 
-from damage_dolfinx.constitutive import B, Phi_L, eps
-from damage_dolfinx.contact import normal_compliance_term
+from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
+from damage_dolfinx.numerics.contact import normal_compliance_term
 
-from .elastic_damage import load
+from damage_dolfinx.forms.elastic_damage import load
 
 
 def memory_integrand(u, zeta, E, nu, L_trunc):

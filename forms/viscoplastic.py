@@ -11,9 +11,9 @@ the cell values at the centroid (interpolation into DG0 = L2 projection; tested)
 """
 import ufl
 
-from damage_dolfinx.constitutive import B, Phi_L, eps
+from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
 
-from .elastic_damage import load
+from damage_dolfinx.forms.elastic_damage import load
 
 
 def viscoplastic_rate(sigma, zeta, L_trunc, sign=1.0):

@@ -9,7 +9,7 @@ import numpy as np
 
 from damage_dolfinx import compat
 
-from . import Geometry
+from damage_dolfinx.geometries import Geometry
 
 
 def box(comm, p0, p1, n, boundary: dict) -> Geometry:

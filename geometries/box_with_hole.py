@@ -19,7 +19,7 @@ import numpy as np
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_C, GAMMA_D, GAMMA_N, Geometry
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N, Geometry
 
 
 def _on_grid(value, cells_per_unit):

@@ -29,7 +29,7 @@ import numpy as np
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
+from damage_dolfinx.geometries import GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
 
 #: traction-free exterior faces
 FREE = 4

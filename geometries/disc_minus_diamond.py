@@ -7,7 +7,7 @@ import gmsh
 
 from damage_dolfinx import compat
 
-from . import GAMMA_D, GAMMA_N, Geometry, gmsh_session
+from damage_dolfinx.geometries import GAMMA_D, GAMMA_N, Geometry, gmsh_session
 
 
 def disc_minus_diamond(comm, h: float = 0.1, h_corner: float = 0.05, R: float = 4.0,

@@ -11,7 +11,7 @@ import gmsh
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_C, GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
 
 #: traction-free sides
 FREE = 4

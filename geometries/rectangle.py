@@ -9,7 +9,7 @@ import numpy as np
 
 from damage_dolfinx import compat
 
-from . import Geometry, StructuredGrid
+from damage_dolfinx.geometries import Geometry, StructuredGrid
 
 
 def rectangle(comm, p0, p1, nx: int, ny: int, boundary: dict) -> Geometry:

@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from . import GAMMA_C, Geometry
-from .rectangle import rectangle, side
+from damage_dolfinx.geometries import GAMMA_C, Geometry
+from damage_dolfinx.geometries.rectangle import rectangle, side
 
 #: inclination of the plane (thesis: 45 degrees)
 SLOPE_ANGLE = math.pi / 4

@@ -11,7 +11,7 @@ import numpy as np
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_D, GAMMA_N, Geometry, StructuredGrid
+from damage_dolfinx.geometries import GAMMA_D, GAMMA_N, Geometry, StructuredGrid
 
 
 def square_with_hole(comm, n: int, side: float = 5.0, hole=(2.0, 3.0)) -> Geometry:

@@ -26,8 +26,8 @@ import numpy as np
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_C, GAMMA_D, GAMMA_N, gmsh_session
-from .bridge import FREE, RING, SPAN, RISE, THICKNESS, ArchGeometry, _build_model, arch_dimensions
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N, gmsh_session
+from damage_dolfinx.geometries.bridge import FREE, RING, SPAN, RISE, THICKNESS, ArchGeometry, _build_model, arch_dimensions
 
 #: traction-free end faces z = 0 and z = W (ends="free")
 END = 5

@@ -24,7 +24,7 @@ import gmsh
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_C, GAMMA_N, Geometry, gmsh_session
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_N, Geometry, gmsh_session
 
 #: traction-free exterior faces
 FREE = 4

@@ -20,8 +20,8 @@ import gmsh
 
 from damage_dolfinx.parameters import InputError
 
-from . import GAMMA_C, GAMMA_N, Geometry, gmsh_session
-from .wrench import FREE, _build, _check, _classify, _mesh_sizes, _to_mesh
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_N, Geometry, gmsh_session
+from damage_dolfinx.geometries.wrench import FREE, _build, _check, _classify, _mesh_sizes, _to_mesh
 
 __all__ = ["wrench_plate", "FREE"]
 

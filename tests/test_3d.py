@@ -11,7 +11,8 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx import compat, constitutive as C
+from damage_dolfinx import compat
+from damage_dolfinx.numerics import constitutive as C
 
 HERE = Path(__file__).parent
 RNG = np.random.default_rng(17)
@@ -147,8 +148,8 @@ def uniaxial_block(k, s0, lam_plus, lam_minus, T=1.0, n=2, comm=MPI.COMM_WORLD):
     Returns (times, zeta per step, e per step, largest deviation from homogeneity)."""
     from damage_dolfinx.geometries.box_with_hole import block
     from damage_dolfinx.parameters import ModelParameters, TimeGrid
-    from damage_dolfinx.problems.base import ProblemData
-    from damage_dolfinx.problems.elastic_2_1 import ElasticDamage
+    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.models.elastic_2_1 import ElasticDamage
     params = ModelParameters(E=E, nu=NU, kappa=1.0, zeta_star=0.01, q_star=1e3, variant="B",
                              lam_D=0.0, lam_u_plus=lam_plus, lam_u_minus=lam_minus,
                              stop_at_zeta_star=False).validate()
@@ -233,7 +234,7 @@ def test_krylov_iterations_bounded_as_h_shrinks():
     """CG + AMG iterations per solve of 2.1-ex1-3d at n = 10, 15, 20 (h halves: 3990 to 27702
     elasticity unknowns): the elasticity count may grow by at most half, the damage count
     (CG + AMG from n = 15 on, direct below 3000 unknowns) stays small."""
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     ex = examples.get("2.1-ex1-3d")
     mech, damage = {}, {}
     for n in (10, 15, 20):
@@ -254,11 +255,11 @@ def test_thin_plate_tends_to_plane_stress():
     together (H = 1, 0.5, 0.25 with n = 10, 20, 40; one layer of cells). The 3-D and 2-D meshes
     differ, so the difference mixes the thickness effect and discretisation: both are first
     order, and the difference must fall by a factor >= 1.5 at each halving."""
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     from damage_dolfinx.geometries.box_with_hole import box_with_hole
     from damage_dolfinx.parameters import TimeGrid
-    from damage_dolfinx.problems.base import ProblemData
-    from damage_dolfinx.problems.elastic_2_1 import ElasticDamage
+    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.models.elastic_2_1 import ElasticDamage
     comm = MPI.COMM_SELF
     ex = examples.get("2.1-ex1")
     diffs = []

@@ -68,8 +68,9 @@ def test_reactions_balance_self_weight_plus_load():
     i.e. self weight is applied everywhere and the patch traction has resultant exactly P."""
     import ufl
     from dolfinx import fem
-    from damage_dolfinx import compat, examples
-    from damage_dolfinx.constitutive import eps
+    from damage_dolfinx import compat
+    from damage_dolfinx.catalogue import examples
+    from damage_dolfinx.numerics.constitutive import eps
     from damage_dolfinx.forms.elastic_damage import stress
     from damage_dolfinx.geometries import GAMMA_D
     stepper = examples.get("2.1-ex3").build(MPI.COMM_WORLD, h=0.2, k=0.001, T=0.01)
@@ -96,7 +97,8 @@ def test_reactions_balance_self_weight_plus_load():
 def test_section_rotation_of_a_rigid_rotation():
     """u = psi (-y, x) (rigid rotation about the arch centre): u_t = -psi r on every section, so
     the measured slope d u_t/d r is -psi everywhere (the hinge rotations are its jumps)."""
-    from damage_dolfinx import compat, examples
+    from damage_dolfinx import compat
+    from damage_dolfinx.catalogue import examples
     stepper = examples.get("2.1-ex3").build(MPI.COMM_WORLD, h=0.2, k=0.001, T=0.01)
     psi = 1e-3
     compat.interpolate(stepper.u, lambda x: np.stack([-psi * x[1], psi * x[0]]))
@@ -175,7 +177,7 @@ def test_literal_linear_step_leaves_the_admissible_set(tmp_path):
 
 def test_damage_bound_is_checked(tmp_path):
     from damage_dolfinx.parameters import InputError
-    from damage_dolfinx.problems.bridge_2_1 import check_bridge_parameters
+    from damage_dolfinx.models.bridge_2_1 import check_bridge_parameters
     with pytest.raises(InputError, match="damage_bound"):
         check_bridge_parameters({"damage_bound": "projection"})
 

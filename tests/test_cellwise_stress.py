@@ -7,8 +7,8 @@ from dolfinx import fem, mesh
 from mpi4py import MPI
 
 from damage_dolfinx import compat
-from damage_dolfinx.cellwise_stress import MemoryIntegrand, StressUpdate
-from damage_dolfinx.constitutive import B, Phi_L, eps
+from damage_dolfinx.numerics.cellwise_stress import MemoryIntegrand, StressUpdate
+from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
 from forms.viscoplastic import stress_update
 
 E, NU = 100.0, 0.3

@@ -4,7 +4,8 @@ import pytest
 import ufl
 from dolfinx import fem
 
-from damage_dolfinx import compat, constitutive as C, damage
+from damage_dolfinx import compat
+from damage_dolfinx.numerics import constitutive as C, damage
 from damage_dolfinx.parameters import ModelParameters
 
 RNG = np.random.default_rng(2007)

@@ -32,10 +32,10 @@ def test_block_on_normal_compliance_foundation_closed_form():
     uniformly by u.nu = p/c_nu and u = (nu p x/E, nu p y/E, -p/c_nu - p z/E), linear, which P1
     reproduces to round-off. Solved with the 2.3 residual (2.137, no memory) and the package's
     semismooth Newton; checked at every node and by the 3-D contact monitor of 3.3."""
-    from damage_dolfinx.boundary import bilateral_plane_faces
+    from damage_dolfinx.numerics.boundary import bilateral_plane_faces
     from damage_dolfinx.forms.viscoelastic_memory import displacement_residual
-    from damage_dolfinx.monitors import ContactMonitor
-    from damage_dolfinx.solvers import NonlinearSolver, SolveContext
+    from damage_dolfinx.models.monitors import ContactMonitor
+    from damage_dolfinx.numerics.solvers import NonlinearSolver, SolveContext
 
     E, nu, c_nu, p = 100.0, 0.3, 1e4, 10.0
     geometry = _block(3)
@@ -74,7 +74,7 @@ def test_contact_monitor_normals_on_3d_facets():
     """The 3-D contact monitor: each Gamma_C triangle's normal is the outward unit normal of
     its face (bottom of the cube: (0, 0, -1)), so a downward rigid shift d is a penetration d
     at every vertex, an upward one none."""
-    from damage_dolfinx.monitors import ContactMonitor
+    from damage_dolfinx.models.monitors import ContactMonitor
     geometry = _block(2)
     V = compat.vector_p1(geometry.mesh)
     monitor = ContactMonitor(V, geometry.facet_tags, GAMMA_C, 0.0)
@@ -168,8 +168,8 @@ def test_dynamic_block_contact_force_balance(n):
     y-momentum. n = 3: factorised velocity matrix; n = 10 (3993 unknowns): CG + GAMG."""
     from damage_dolfinx.geometries.box import box, face
     from damage_dolfinx.parameters import ModelParameters, TimeGrid
-    from damage_dolfinx.problems.base import ProblemData
-    from damage_dolfinx.problems.dynamic_3_1 import DynamicKelvinVoigt
+    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
     p, rho, c_nu, k = 20.0, 1.0, 2e4, 0.01
     geometry = box(MPI.COMM_WORLD, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (n, n, n),
                    {GAMMA_C: face(2, 0.0), GAMMA_N: face(2, 1.0)})

@@ -9,9 +9,9 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from damage_dolfinx import compat
-from damage_dolfinx.damage import DamageStep
-from damage_dolfinx.post import loglog_rate
-from damage_dolfinx.solvers import SolveContext
+from damage_dolfinx.numerics.damage import DamageStep
+from damage_dolfinx.viz.post import loglog_rate
+from damage_dolfinx.numerics.solvers import SolveContext
 
 KAPPA = 0.1
 

@@ -8,14 +8,16 @@ import ufl
 from mpi4py import MPI
 
 from conftest import load_run, run_cli, serial_and_two_ranks
-from damage_dolfinx import compat, examples, stability
-from damage_dolfinx.boundary import clamped
-from damage_dolfinx.constitutive import B_plane_stress, eps
+from damage_dolfinx import compat
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.numerics import stability
+from damage_dolfinx.numerics.boundary import clamped
+from damage_dolfinx.numerics.constitutive import B_plane_stress, eps
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
 from damage_dolfinx.parameters import InputError, TimeGrid
-from damage_dolfinx.problems.base import ProblemData
-from damage_dolfinx.problems.dynamic_3_1 import DynamicKelvinVoigt
+from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
 
 COMM = MPI.COMM_WORLD
 

@@ -16,8 +16,8 @@ def _block_stepper(f, g, rho, k=0.02, T=0.1, L=2.0, H=1.0):
     from damage_dolfinx.geometries import GAMMA_C
     from damage_dolfinx.geometries.rectangle import rectangle, side
     from damage_dolfinx.parameters import ModelParameters, TimeGrid
-    from damage_dolfinx.problems.base import ProblemData
-    from damage_dolfinx.problems.dynamic_tresca_3_2 import DynamicTresca
+    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.models.dynamic_tresca_3_2 import DynamicTresca
     geometry = rectangle(MPI.COMM_WORLD, (0, 0), (L, H), 8, 4, {GAMMA_C: side(1, 0.0)})
     params = ModelParameters(
         E=1e4, nu=0.3, kappa=1.0, zeta_star=0.01, variant="A", lam_D=0.0, lam_u=0.0, lam_w=0.0,

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 
 from conftest import ENV, load_run, rel_diff, run_cli
-from damage_dolfinx import atomic, cli, io
+from damage_dolfinx.runtime import atomic, io
+from damage_dolfinx import cli
 
 RUN = ["run", "2.4-ex1", "--n", "8", "--k", "0.01", "--T", "0.6", "--no-figures", "--quiet"]
 #: long enough (1500 steps) to be stopped by a signal while it runs
@@ -272,7 +273,7 @@ def test_lagged_factorisation_is_restored_on_restart(tmp_path, capsys, monkeypat
     the uninterrupted run (the factorisation rebuilt from the current damage instead: 5.6e-13
     with the default lag, one factorisation in the run; 5.7e-14 with refactorisations after
     4 CG iterations, 6 in the run, here 4 restarts)."""
-    from damage_dolfinx.problems import elastic_2_1
+    from damage_dolfinx.models import elastic_2_1
     if refactor_its:
         monkeypatch.setattr(elastic_2_1, "MECH_REFACTOR_ITS", refactor_its)
     base = ["run", "2.1-ex1", "--n", "5", "--k", "0.01", "--no-figures", "--quiet",

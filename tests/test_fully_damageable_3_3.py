@@ -14,8 +14,8 @@ from damage_dolfinx import compat
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
 from damage_dolfinx.parameters import ModelParameters, TimeGrid
-from damage_dolfinx.problems.base import ProblemData
-from damage_dolfinx.problems.fully_damageable_3_3 import FullyDamageableContact
+from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.models.fully_damageable_3_3 import FullyDamageableContact
 
 
 def _params(lam_u=0.0, **extra):
@@ -49,7 +49,7 @@ def _run(stepper):
 def test_zeta_one_equals_section_3_1():
     """No damage evolution (lam = 0, zeta_0 = 1): the 3.3 fields are the 3.1 fields."""
     try:
-        from damage_dolfinx.problems.dynamic_3_1 import DynamicKelvinVoigt
+        from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
     except ImportError as exc:  # pragma: no cover
         pytest.skip(f"Section 3.1 stepper not available: {exc}")
     geo = _square(4)
@@ -211,7 +211,7 @@ def test_fast_velocity_matrix_equals_reassembly():
     """Issue 18: the matrix of (3.159) updated from the nodal zeta_n by the precomputed sparse
     map equals the re-assembled one to round-off, Dirichlet rows included, for any zeta in K^h;
     an unchanged zeta leaves the matrix untouched."""
-    from damage_dolfinx.zeta_linear import VelocitySolver
+    from damage_dolfinx.numerics.zeta_linear import VelocitySolver
     s = FullyDamageableContact(_data(_params(), 0.01, 0.05, _square(6)))
     if MPI.COMM_WORLD.size > 1:
         pytest.skip("the sparse map is serial; in parallel the matrix is re-assembled")
@@ -236,7 +236,7 @@ def test_fast_velocity_rhs_equals_assembly():
     """Issue 18, Phi_L = identity (L_trunc = inf, the wrench): the right-hand side of (3.159)
     as rho/k M v_{n-1} - K_B(zeta_{n-1}) u_{n-1} + assembled contact and load equals the
     assembled l to round-off, with the contact term active."""
-    from damage_dolfinx.solvers import LinearSolver
+    from damage_dolfinx.numerics.solvers import LinearSolver
     if MPI.COMM_WORLD.size > 1:
         pytest.skip("the sparse maps are serial; in parallel l is assembled")
     params = _params().replace(L_trunc=float("inf"))
@@ -294,7 +294,7 @@ def test_history_cadence_and_restart(tmp_path):
 def test_contact_maximum_is_checkpointed():
     """The maximal interpenetration so far (value, time, place) goes into the checkpoint state
     and comes back on restore(), so a resumed run reports the maximum over the whole run."""
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     build = lambda: examples.get("3.3-ex3").build(  # noqa: E731
         MPI.COMM_WORLD, h=0.5, k=1e-5, T=1e-4, overrides={"stability_check": "off"})
     s = build()

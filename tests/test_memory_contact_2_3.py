@@ -10,8 +10,8 @@ from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
 from damage_dolfinx.geometries.rectangle import rectangle, side
 from damage_dolfinx.parameters import ModelParameters, TimeGrid
-from damage_dolfinx.problems.base import ProblemData
-from damage_dolfinx.problems.memory_2_3 import ViscoelasticMemoryContact
+from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.models.memory_2_3 import ViscoelasticMemoryContact
 
 
 def pushed_block(c_nu, E=100.0, H=2.0, g0=0.01, n=4):
@@ -108,8 +108,8 @@ def test_split_jacobian_equals_assembly():
     equals the full assembly, Dirichlet rows included, at a state in contact on part of Gamma_C;
     a residual whose cell part depends on u is not split."""
     import ufl
-    from damage_dolfinx.boundary import clamped
-    from damage_dolfinx.callbacks import constant_cell_jacobian, form_callbacks, relative_change
+    from damage_dolfinx.numerics.boundary import clamped
+    from damage_dolfinx.numerics.callbacks import constant_cell_jacobian, form_callbacks, relative_change
     from damage_dolfinx.forms.viscoelastic_memory import displacement_residual
     from damage_dolfinx.geometries import GAMMA_N
     params = ModelParameters(E=100.0, nu=0.3, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,

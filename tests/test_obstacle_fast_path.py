@@ -11,8 +11,8 @@ from petsc4py import PETSc
 
 from conftest import load_run, rel_diff, run_cli
 from damage_dolfinx import compat
-from damage_dolfinx.damage import DamageStep
-from damage_dolfinx.solvers import SolveContext
+from damage_dolfinx.numerics.damage import DamageStep
+from damage_dolfinx.numerics.solvers import SolveContext
 
 ZETA_STAR, K, KAPPA = 0.01, 0.05, 0.05
 
@@ -150,8 +150,8 @@ def test_cellwise_source_equals_the_assembled_right_hand_side(unit_square):
     computed by sparse maps (cellwise_source.py); same l and same step as the assembly, also
     where Psi_q is capped; lam_D != 0 keeps the assembly."""
     from types import SimpleNamespace
-    from damage_dolfinx.constitutive import eps
-    from damage_dolfinx.damage import source
+    from damage_dolfinx.numerics.constitutive import eps
+    from damage_dolfinx.numerics.damage import source
     msh = unit_square(12)
     Z, V = compat.scalar_p1(msh), compat.vector_p1(msh)
     u_old = fem.Function(V)

@@ -8,7 +8,8 @@ import re
 
 import pytest
 
-from damage_dolfinx import cli, examples
+from damage_dolfinx import cli
+from damage_dolfinx.catalogue import examples
 
 
 def test_literal_is_the_stated_data_and_evidence_departs_with_reasons():

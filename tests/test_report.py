@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from damage_dolfinx import report, reproduce
+from damage_dolfinx.report import build, reproduce
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -60,7 +60,7 @@ def _damage_bars_fixed_and_factors_round(out, index):
     """Every field figure of a quick run: the damage colour bar, read back from the drawn
     figure, spans [zeta*, 1] (or reaches below zeta* only where the field does); every
     amplification factor in the index is round."""
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     npzs = sorted((out / "runs").rglob("*" + figstyle.PANEL_SUFFIX))
     assert npzs
     for npz in npzs:
@@ -101,7 +101,7 @@ def test_resumed_reproduction_keeps_completed_runs(tmp_path):
 def test_markdown_norm_at_line_start_is_text_not_a_table():
     """benchmarks/readings.md wraps lines that begin with a norm ('||eps(u)||_L2 = ...'): a
     pipe table needs its delimiter row, as in GitHub Markdown."""
-    from damage_dolfinx import report_doc
+    from damage_dolfinx.report import doc
     html = report_doc._markdown_to_html("a reading,\n||eps(u)||_L2 = 1e-3, so\n\n| n | k |\n"
                                         "|---|--:|\n| 4 | 0.1 |\n")
     assert html.count("<table>") == 1 and "<p>a reading, ||eps(u)||_L2 = 1e-3, so</p>" in html

@@ -4,7 +4,8 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx import compat, post
+from damage_dolfinx import compat
+from damage_dolfinx.viz import post
 from damage_dolfinx.geometries.square_with_hole import square_with_hole
 
 

@@ -71,8 +71,8 @@ def _friction_problem(contact_sides):
     from dolfinx import fem, mesh
     from mpi4py import MPI
     from damage_dolfinx import compat
-    from damage_dolfinx.friction import FrictionProblem
-    from damage_dolfinx.solvers import SolveContext
+    from damage_dolfinx.numerics.friction import FrictionProblem
+    from damage_dolfinx.numerics.solvers import SolveContext
     msh = mesh.create_unit_square(MPI.COMM_WORLD, 6, 6)
     msh.topology.create_connectivity(1, 2)
     sides = {"left": lambda x: np.isclose(x[0], 0.0), "bottom": lambda x: np.isclose(x[1], 0.0),
@@ -96,7 +96,7 @@ def test_algebraic_friction_residual():
     """The Newton residual A v - b + sum_i m_i Phi_eps(v_tau,i) tau_i (no assembly) equals the
     assembled UFL residual on a straight Gamma_C, so both give the same velocity; on a bent
     Gamma_C (a corner node) it does not, and the solver falls back to assembly."""
-    from damage_dolfinx.friction import RegularisedNewton
+    from damage_dolfinx.numerics.friction import RegularisedNewton
     velocities = []
     for force_assembly in (False, True):
         newton = RegularisedNewton(_friction_problem(("bottom",)), eps_reg=1e-9)
@@ -132,8 +132,8 @@ def _shear_block(mu, lam, g, side_shear, top_shear=None, top_velocity=None):
     from dolfinx import fem, mesh
     from mpi4py import MPI
     from damage_dolfinx import compat
-    from damage_dolfinx.friction import FrictionProblem
-    from damage_dolfinx.solvers import SolveContext
+    from damage_dolfinx.numerics.friction import FrictionProblem
+    from damage_dolfinx.numerics.solvers import SolveContext
     msh = mesh.create_rectangle(MPI.COMM_WORLD, [np.zeros(2), np.array([2.0, 1.0])], [8, 4])
     msh.topology.create_connectivity(1, 2)
     where = {1: lambda x: np.isclose(x[1], 0.0), 2: lambda x: np.isclose(x[1], 1.0),
@@ -166,7 +166,7 @@ def test_friction_solvers_reproduce_simple_shear():
     velocity 2.5 > g H / mu = 1.5, the bottom slides at v_b = 2.5 - 1.5 = 1 under the friction
     stress g (the friction force equals g times the contact length). Newton for both; Uzawa and
     penalty-duality for the slip case."""
-    from damage_dolfinx.friction import make_solver
+    from damage_dolfinx.numerics.friction import make_solver
     mu, lam, g, eps = 2.0, 1.0, 3.0, 1e-9
     cases = [("stick", dict(side_shear=1.0, top_shear=1.0), eps * 1.0 / g, 1.0, ["newton"]),
              ("slip", dict(side_shear=g, top_velocity=2.5), 1.0, g,
@@ -189,7 +189,7 @@ def test_primal_dual_active_set_from_a_reversed_start():
     """The primal-dual active-set iteration alone (PrimalDualActiveSet), started from a velocity
     sliding the wrong way (v = (-1, 0)), reaches the closed-form stick and slip solutions of the
     simple-shear block to the primal Newton's accuracy."""
-    from damage_dolfinx.friction import ContactNodes, AlgebraicResidual, PrimalDualActiveSet
+    from damage_dolfinx.numerics.friction import ContactNodes, AlgebraicResidual, PrimalDualActiveSet
     from dolfinx import fem
     from damage_dolfinx import compat
     mu, lam, g, eps = 2.0, 1.0, 3.0, 1e-9
@@ -219,7 +219,7 @@ def test_primal_dual_active_set_shortens_the_hard_steps():
     iterations."""
     from mpi4py import MPI
     from petsc4py import PETSc
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     runs, opts = {}, PETSc.Options()
     for with_pdas in (True, False):
         s = examples.get("2.2-ex1", "literal").build(MPI.COMM_WORLD, n=16, k=0.02)

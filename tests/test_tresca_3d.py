@@ -24,8 +24,8 @@ def _block(top_velocity, side_shear, contact="bottom"):
     from dolfinx import fem, mesh
     from mpi4py import MPI
     from damage_dolfinx import compat
-    from damage_dolfinx.friction import FrictionProblem
-    from damage_dolfinx.solvers import SolveContext
+    from damage_dolfinx.numerics.friction import FrictionProblem
+    from damage_dolfinx.numerics.solvers import SolveContext
     msh = mesh.create_box(MPI.COMM_WORLD, [np.zeros(3), np.array([2.0, 1.5, H])], [4, 3, 2])
     msh.topology.create_connectivity(2, 3)
     where = {1: lambda x: np.isclose(x[2], 0.0), 2: lambda x: np.isclose(x[2], H),
@@ -83,7 +83,7 @@ def _check(problem, v_b, s, tol, label):
 def test_sliding_block_closed_form(kind):
     """Newton on Phi_eps (eps = 1e-9), Uzawa (eps = 0) and penalty-duality (eps = 1e-9) on the
     3-D stick and slip cases: the P1 solution is the closed-form simple shear."""
-    from damage_dolfinx.friction import make_solver
+    from damage_dolfinx.numerics.friction import make_solver
     eps = 1e-9
     for name, top, v_b, s in _cases(0.0 if kind == "uzawa" else eps):
         problem = _block(top, s)
@@ -100,7 +100,7 @@ def test_primal_dual_active_set_3d_from_a_reversed_start():
     velocity sliding against the shear (v = -d), reaches both closed forms."""
     from dolfinx import fem
     from damage_dolfinx import compat
-    from damage_dolfinx.friction import AlgebraicResidual, ContactNodes, PrimalDualActiveSet
+    from damage_dolfinx.numerics.friction import AlgebraicResidual, ContactNodes, PrimalDualActiveSet
     eps = 1e-9
     for name, top, v_b, s in _cases(eps):
         problem = _block(top, s)
@@ -119,7 +119,7 @@ def test_primal_dual_active_set_3d_from_a_reversed_start():
 def test_edge_between_contact_faces_is_refused():
     """Tresca on two faces meeting at an edge: the edge nodes have no coordinate-plane tangent
     plane; refused with one clear InputError before any solve."""
-    from damage_dolfinx.friction import make_solver
+    from damage_dolfinx.numerics.friction import make_solver
     from damage_dolfinx.parameters import InputError
     with pytest.raises(InputError, match="coordinate plane"):
         make_solver("newton", _block(1.0, 1.0, contact="bottom and side"), eps_reg=1e-9,
@@ -170,7 +170,7 @@ def test_viscoplastic_stepper_takes_the_dimension_from_the_mesh():
     import dataclasses
     import ufl
     from mpi4py import MPI
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     from damage_dolfinx.catalogue.section_3d_tresca import _unit_cube
     ex = dataclasses.replace(
         examples.get("2.4-ex1", "literal"), dim=3, make_geometry=_unit_cube, literal=None,

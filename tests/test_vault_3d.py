@@ -63,7 +63,7 @@ def test_vault_geometry_counts_and_tags():
 
 
 def vault_stepper(monkeypatch, **geometry):
-    from damage_dolfinx import examples
+    from damage_dolfinx.catalogue import examples
     from damage_dolfinx.catalogue import bridge
     monkeypatch.setattr(bridge, "VAULT_GEOMETRY", {**COARSE, **geometry})
     return examples.get("2.1-ex3-vault").build(MPI.COMM_WORLD, h=H, k=0.001, T=0.01)
@@ -75,7 +75,7 @@ def test_line_load_and_self_weight_balance_the_reactions(monkeypatch):
     import ufl
     from dolfinx import fem
     from damage_dolfinx import compat
-    from damage_dolfinx.constitutive import eps
+    from damage_dolfinx.numerics.constitutive import eps
     from damage_dolfinx.forms.elastic_damage import stress
     from damage_dolfinx.geometries import GAMMA_D
     stepper = vault_stepper(monkeypatch)
@@ -111,7 +111,7 @@ def test_width_averaged_rotation_of_a_rigid_rotation(monkeypatch):
 
 def run_coarse(out, monkeypatch=None, np_=1):
     if np_ == 1:
-        from damage_dolfinx import runner
+        from damage_dolfinx.runtime import runner
         from damage_dolfinx.catalogue import bridge
         monkeypatch.setattr(bridge, "VAULT_GEOMETRY", dict(COARSE))
         return runner.run("2.1-ex3-vault", out, h=H, progress=False, figures=False)

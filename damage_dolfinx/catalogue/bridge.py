@@ -11,21 +11,9 @@ Readings (issue 16): ``literal`` keeps the linear damage step (2.20), whose zeta
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 
-from ..examples import Example, Figure, Reading
-from ..parameters import ModelParameters
-
-
-@dataclass
-class BridgeParameters(ModelParameters):
-    """ModelParameters whose validate() also checks the bridge data in ``extra``."""
-
-    def validate(self):
-        from ..problems.bridge_2_1 import check_bridge_parameters
-        super().validate()
-        check_bridge_parameters(self.extra)
-        return self
+from damage_dolfinx.catalogue.examples import Example, Figure, Reading
+from damage_dolfinx import ModelParameters
 
 
 #: CALIBRATED (the only calibrated parameter): dP/dt of the quarter-span load [kN/s]. With the
@@ -64,10 +52,11 @@ EVIDENCE = Reading(
 
 
 def examples():
-    from ..geometries.bridge import RADIUS_CENTRE, THICKNESS, arch_bridge
-    from ..problems.bridge_2_1 import BRIDGE_DEFAULTS, BridgeDamage
+    from damage_dolfinx.geometries.bridge import RADIUS_CENTRE, THICKNESS, arch_bridge
+    from damage_dolfinx import model_defaults
+    BRIDGE_DEFAULTS = model_defaults("2.1-collapse").extra
 
-    params = BridgeParameters(
+    params = ModelParameters(
         E=5e9, nu=0.49, kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="B",
         lam_D=2e-3, lam_u_plus=5e9, lam_u_minus=5e9, lam_w=7e-4, stop_at_zeta_star=False,
         extra=dict(BRIDGE_DEFAULTS, load_rate=LOAD_RATE, damage_bound="none"))
@@ -77,7 +66,7 @@ def examples():
               "and hinges",
         params=params, T=0.3, k=1e-3, h=0.05, diameter=2 * (RADIUS_CENTRE + THICKNESS / 2),
         make_geometry=lambda comm, n, h: arch_bridge(comm, h=h),
-        make_stepper=BridgeDamage,
+        model="2.1-collapse",
         assumptions=[
             "G3: semicircular ring, centre-line radius 15/pi = 4.775 m (centre line 15.0 m), "
             "thickness 0.70 m (intrados radius 4.425 m, clear span 8.85 m, rise 4.425 m); no "
@@ -142,7 +131,7 @@ def vault_example(ex3):
     same data and load rate, the point load become a line load across the width."""
     from dataclasses import replace
 
-    from ..geometries.vault import barrel_vault
+    from damage_dolfinx.geometries.vault import barrel_vault
     return replace(
         ex3, id="2.1-ex3-vault", dim=3, h=VAULT_H,
         title=f"3-D: the arch ring extruded to a barrel vault {VAULT_WIDTH:g} m wide, line load "

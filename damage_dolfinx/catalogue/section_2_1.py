@@ -3,14 +3,13 @@ import math
 
 import ufl
 
-from ..examples import Example, Figure
-from ..parameters import ModelParameters
+from damage_dolfinx.catalogue.examples import Example, Figure
+from damage_dolfinx import ModelParameters
 
 
 def examples():
-    from ..geometries.disc_minus_diamond import disc_minus_diamond
-    from ..geometries.square_with_hole import square_with_hole
-    from ..problems.elastic_2_1 import ElasticDamage
+    from damage_dolfinx.geometries.disc_minus_diamond import disc_minus_diamond
+    from damage_dolfinx.geometries.square_with_hole import square_with_hole
 
     common = dict(E=1e4, nu=0.33, kappa=1.0, zeta_star=0.01, q_star=1000.0, variant="B",
                   lam_D=0.1, lam_w=0.0, stop_at_zeta_star=True)
@@ -29,7 +28,7 @@ def examples():
         params=ModelParameters(**common, lam_u_plus=1000.0, lam_u_minus=100.0),
         T=1.0, k=0.01, n=20, diameter=5 * math.sqrt(2),
         make_geometry=lambda comm, n, h: square_with_hole(comm, n),
-        make_stepper=ElasticDamage,
+        model="2.1",
         body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t)),
         assumptions=common_assumptions + [
             "G10: structured n x n grid, diagonals 'right', hole cells removed (nested meshes)",
@@ -46,7 +45,7 @@ def examples():
             params=ModelParameters(**common, lam_u_plus=lam_plus, lam_u_minus=lam_minus),
             T=1.0, k=0.01, h=0.1, diameter=8.0,
             make_geometry=lambda comm, n, h: disc_minus_diamond(comm, h=h, h_corner=h / 2),
-            make_stepper=ElasticDamage,
+            model="2.1",
             traction=lambda x, t: ufl.as_vector((5.0 * x[1] * t, -5.0 * x[0] * t)),
             assumptions=common_assumptions + [
                 "G2: Gamma_D = inner diamond |x1|+|x2| = 1 (clamped), Gamma_N = circle",

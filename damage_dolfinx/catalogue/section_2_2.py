@@ -4,9 +4,9 @@ import math
 
 import ufl
 
-from ..examples import Example, Figure, Reading
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..parameters import ModelParameters
+from damage_dolfinx.catalogue.examples import Example, Figure, Reading
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx import ModelParameters
 
 #: G8: Uzawa step from log-spaced sweeps: at n = 16, k = 0.01 (all nodes slip) rho = 1, 10, 100 give
 #: 2 iterations per step (Newton solution to 2e-14), rho = 0.01 needs 25; at k = 0.02 (stick-slip)
@@ -38,8 +38,7 @@ EVIDENCE = Reading(
 
 
 def examples():
-    from ..geometries.rectangle import rectangle, side
-    from ..problems.kelvin_voigt_2_2 import KelvinVoigtTresca
+    from damage_dolfinx.geometries.rectangle import rectangle, side
 
     common = [
         "G6: kappa = 1e-2 (missing in the thesis)",
@@ -58,7 +57,7 @@ def examples():
         GAMMA_D: side(0, 0.0), GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)})
     layout = "G5: Gamma_D = {0}x[0,1], f_N on {1}x[0,1], top free, Gamma_C = [0,1]x{0}"
     test1 = dict(params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),  # Ex. 1-2
-                 make_geometry=square, make_stepper=KelvinVoigtTresca,
+                 make_geometry=square, model="2.2",
                  traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)))
     ex1 = Example(
         id="2.2-ex1", section="2.2", readings={"evidence": EVIDENCE}, default_reading="evidence",
@@ -79,7 +78,7 @@ def examples():
         params=_params(45.0), T=5.0, k=0.005, n=40, diameter=4 * math.sqrt(2),
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 4), n, n, {
             GAMMA_C: lambda x: side(1, 0.0)(x) | side(1, 4.0)(x)}),
-        make_stepper=KelvinVoigtTresca,
+        model="2.2",
         body_force=lambda x, t: ufl.as_vector((100.0 * ufl.sin(math.pi * t / 2.0), 0.0)),
         builders={"friction_bound": lambda x: ufl.conditional(ufl.lt(x[1], 2.0), 45.0, 1000.0),
                   "probe": (4.0, 0.0)},

@@ -2,14 +2,13 @@
 normal compliance, damage by the PDE (1.5), variant A)."""
 import ufl
 
-from ..examples import Example, Figure
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..parameters import ModelParameters
+from damage_dolfinx.catalogue.examples import Example, Figure
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx import ModelParameters
 
 
 def examples():
-    from ..geometries.rectangle import rectangle, side
-    from ..problems.memory_2_3 import ViscoelasticMemoryContact
+    from damage_dolfinx.geometries.rectangle import rectangle, side
 
     def params(E, kernel):
         return ModelParameters(
@@ -36,7 +35,7 @@ def examples():
         params=params(100.0, "constant"), T=1.0, k=0.01, n=16, diameter=2 ** 0.5,
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {
             GAMMA_D: side(0, 0.0), GAMMA_C: side(1, 0.0), GAMMA_N: side(0, 1.0)}),
-        make_stepper=ViscoelasticMemoryContact,
+        model="2.3",
         traction=lambda x, t: ufl.as_vector((-10.0, -10.0)),
         assumptions=common + ["G10: structured n x n grid, diagonals right (nested meshes)",
                               "memory kernel G = zeta Phi_L(B eps) (constant in t - s): running sum"],
@@ -50,7 +49,7 @@ def examples():
         params=params(1000.0, "constant"), T=2.0, k=0.01, n=10, diameter=13 ** 0.5,
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (3, 2), 3 * n, 2 * n, {
             GAMMA_D: side(1, 0.0), GAMMA_C: side(0, 0.0, 0.0, 1.0), GAMMA_N: side(0, 3.0)}),
-        make_stepper=ViscoelasticMemoryContact,
+        model="2.3",
         traction=lambda x, t: ufl.as_vector((-30.0, 0.0)),
         assumptions=common + ["G13: Omega = (0,3)x(0,2), load (-30,0) on {3}x[0,2], mesh 30x20 "
                               "(--n 10 = 10 cells per unit length), k = 0.01"],
@@ -65,7 +64,7 @@ def examples():
         params=params(1000.0, "exponential"), T=1.0, k=0.01, n=20, diameter=17 ** 0.5,
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 1), 4 * n, n, {
             GAMMA_D: side(0, 0.0), GAMMA_C: side(1, 0.0, 3.0, 4.0), GAMMA_N: side(1, 1.0)}),
-        make_stepper=ViscoelasticMemoryContact,
+        model="2.3",
         traction=lambda x, t: ufl.as_vector((0.0, ufl.conditional(ufl.le(t, 0.5 + 1e-12), -10.0, 0.0))),
         assumptions=common + ["G14: cantilever (0,4)x(0,1), Gamma_D = {0}x[0,1], Gamma_C = [3,4]x{0}, "
                               "load on the top face, mesh 80x20 (--n 20 = cells per unit length), k = 0.01",

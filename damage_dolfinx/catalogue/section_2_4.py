@@ -4,13 +4,13 @@ import math
 
 import ufl
 
-from ..examples import Example, Figure, Reading
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from .section_2_2 import OMEGA_PD, RHO_UZAWA
+from damage_dolfinx.catalogue.examples import Example, Figure, Reading
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.catalogue.section_2_2 import OMEGA_PD, RHO_UZAWA
 
 
 def _params(g_fric, law="tresca"):
-    from ..parameters import ModelParameters
+    from damage_dolfinx import ModelParameters
     return ModelParameters(  # G17: the damage data of Section 2.2
         E=1000.0, nu=0.3, kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.1,
         lam_u=1000.0, lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False,
@@ -37,8 +37,7 @@ EVIDENCE_EX1 = Reading(
 
 
 def examples():
-    from ..geometries.rectangle import rectangle, side
-    from ..problems.viscoplastic_2_4 import ElastoViscoplasticFriction
+    from damage_dolfinx.geometries.rectangle import rectangle, side
 
     common = [
         "G17: no damage data in Section 2.4 -> variant A, zeta_star = 0.01, q_star = 1000, "
@@ -61,7 +60,7 @@ def examples():
         title="unit square, traction (50,0)e^t, Tresca g = 0.7 (P1) or simplified Coulomb "
               "mu_f = 0.05, S_n = 10 (P2; --friction-law coulomb): convergence",
         params=_params(0.7), T=1.0, k=0.002, n=64, diameter=math.sqrt(2),
-        make_geometry=square, make_stepper=ElastoViscoplasticFriction,
+        make_geometry=square, model="2.4",
         traction=lambda x, t: ufl.as_vector((50.0 * ufl.exp(t), 0.0)),
         assumptions=common + [
             "Gamma_D = {0}x[0,1], f_N on {1}x(0,1), top free, Gamma_C = [0,1]x{0}",
@@ -79,7 +78,7 @@ def examples():
         params=_params(1000.0), T=1.0, k=0.002, n=64, diameter=math.sqrt(2),
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {
             GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)}),
-        make_stepper=ElastoViscoplasticFriction,
+        model="2.4",
         traction=lambda x, t: ufl.as_vector((55.0 * ufl.exp(t), 0.0)),
         assumptions=common + [
             "G18: Gamma_C = [0,1]x{0}, f_N on {1}x(0,1), rest traction-free, Gamma_D empty",

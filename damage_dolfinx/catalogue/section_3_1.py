@@ -5,9 +5,9 @@ import math
 import numpy as np
 import ufl
 
-from ..examples import Example, Figure, Reading
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..parameters import ModelParameters
+from damage_dolfinx.catalogue.examples import Example, Figure, Reading
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx import ModelParameters
 
 
 def _params(E, rho, lam_D, c_nu):
@@ -23,7 +23,7 @@ def _params(E, rho, lam_D, c_nu):
 def layout_example1():
     """G23: boundary parts of Ex. 1 (thesis Figure 3.1 missing): clamped at x_1 = 0 and 6, loaded
     top, contact below (the 3.3 Ex. 1 layout); {tag: marker}, change here to try other readings."""
-    from ..geometries.rectangle import side
+    from damage_dolfinx.geometries.rectangle import side
     return {GAMMA_D: lambda x: side(0, 0.0)(x) | side(0, 6.0)(x), GAMMA_N: side(1, 6.0),
             GAMMA_C: side(1, 0.0)}
 
@@ -51,9 +51,8 @@ EVIDENCE_EX1 = Reading(
 
 
 def examples():
-    from ..geometries.lshape import lshape
-    from ..geometries.rectangle import rectangle, side
-    from ..problems.dynamic_3_1 import DynamicKelvinVoigt
+    from damage_dolfinx.geometries.lshape import lshape
+    from damage_dolfinx.geometries.rectangle import rectangle, side
 
     common = [
         "G22: q_star = 1 (the value every 3.1 example lists), L_trunc = 1000, variant A",
@@ -76,7 +75,7 @@ def examples():
         params=_params(1000.0, 1.0, 1e-2, 2e4), T=1.0, k=0.01, n=16, diameter=6 * math.sqrt(2),
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (6, 6), n, n,
                                                    layout_example1()),
-        make_stepper=DynamicKelvinVoigt,
+        model="3.1",
         traction=lambda x, t: ufl.as_vector((20.0 * t, -20.0 * t)),
         assumptions=common + [
             "G23: Gamma_D = {0}x(0,6) and {6}x(0,6), Gamma_N = (0,6)x{6}, Gamma_C = (0,6)x{0} "
@@ -99,7 +98,7 @@ def examples():
         params=_params(100.0, 1.0, 1e-2, 2e4), T=1.0, k=0.004, n=30, diameter=math.sqrt(10),
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (3, 1), 3 * n, n, {
             GAMMA_D: side(0, 0.0), GAMMA_N: side(1, 1.0), GAMMA_C: side(1, 0.0)}),
-        make_stepper=DynamicKelvinVoigt,
+        model="3.1",
         traction=lambda x, t: ufl.as_vector((4.5 * ufl.sin(2 * math.pi * t),
                                              -4.5 * ufl.sin(2 * math.pi * t))),
         zeta0=zeta0_example2,
@@ -127,7 +126,7 @@ def examples():
         params=_params(1e4, 0.05, 5e-4, 2e5), T=10.5, k=0.001, h=1.0 / 32.0,
         diameter=2 * math.sqrt(2),
         make_geometry=lambda comm, n, h: lshape(comm, h),
-        make_stepper=DynamicKelvinVoigt,
+        model="3.1",
         traction=lambda x, t: ufl.as_vector((0.0, -7.0 * abs(ufl.sin(math.pi * t)))),
         assumptions=common + [
             "G26: Omega = (0,2)^2 minus [1,2]x[0,1); Gamma_D = [0,1]x{0}, Gamma_C = [1,2]x{1} "

@@ -5,10 +5,10 @@ import math
 import numpy as np
 import ufl
 
-from ..examples import Example, Figure, Reading
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..parameters import ModelParameters
-from .section_2_2 import OMEGA_PD, RHO_UZAWA
+from damage_dolfinx.catalogue.examples import Example, Figure, Reading
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx import ModelParameters
+from damage_dolfinx.catalogue.section_2_2 import OMEGA_PD, RHO_UZAWA
 
 
 def _params(g_fric, solver="newton"):
@@ -53,9 +53,8 @@ EVIDENCE_EX1 = Reading(
 
 
 def examples():
-    from ..geometries.rectangle import rectangle, side
-    from ..geometries.slope import slope_block
-    from ..problems.dynamic_tresca_3_2 import DynamicTresca
+    from damage_dolfinx.geometries.rectangle import rectangle, side
+    from damage_dolfinx.geometries.slope import slope_block
 
     common = [
         "G22: q_star = 1000 (Chapter 3 value; Section 3.2 lists none), L_trunc = 1000",
@@ -78,7 +77,7 @@ def examples():
         title="unit square, traction (200,0)(e^t - 1) on {0}x[0,1], Tresca g = 5: convergence "
               "(Table 3.2)",
         params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
-        make_geometry=square, make_stepper=DynamicTresca,
+        make_geometry=square, model="3.2",
         traction=lambda x, t: ufl.as_vector((200.0 * (ufl.exp(t) - 1.0), 0.0)),
         builders={"contact_faces": {"bottom": _on(1, 0.0)}},
         assumptions=common + [
@@ -99,7 +98,7 @@ def examples():
         params=_params(1.0), T=3.0, k=0.005, n=20, diameter=math.hypot(4, 2),
         make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 2), 4 * n, 2 * n, {
             GAMMA_C: lambda x: side(1, 0.0)(x) | side(1, 2.0)(x)}),
-        make_stepper=DynamicTresca,
+        model="3.2",
         body_force=lambda x, t: ufl.as_vector((40.0 * ufl.sin(1.5 * math.pi * t), 0.0)),
         builders={"friction_bound": lambda x: ufl.conditional(ufl.gt(x[1], 1.0), 1.0, 1000.0),
                   "contact_faces": {"top": _on(1, 2.0), "bottom": _on(1, 0.0)}},
@@ -128,7 +127,7 @@ def examples():
         title="block on a 45-degree slope held by an obstacle, gravity 40(e^t - 1), Tresca g = 1",
         params=_params(1.0), T=1.0, k=0.005, n=20, diameter=math.hypot(2, 1),
         make_geometry=lambda comm, n, h: slope_block(comm, n),
-        make_stepper=DynamicTresca,
+        model="3.2",
         body_force=lambda x, t: -20.0 * math.sqrt(2) * (ufl.exp(t) - 1.0) * ufl.as_vector((1.0, 1.0)),
         builders={"contact_faces": {"plane": _on(1, 0.0), "obstacle": _on(0, 0.0)}},
         assumptions=common + [

@@ -6,9 +6,9 @@ import math
 import numpy as np
 import ufl
 
-from ..examples import Example, Figure
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..parameters import ModelParameters
+from damage_dolfinx.catalogue.examples import Example, Figure
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx import ModelParameters
 
 #: G33/1.8: default time steps of Examples 2-3, 0.8 k_max or below and dividing T, from
 #: stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)
@@ -51,15 +51,14 @@ def zeta0_bottom(x):
 
 def _square(comm, n):
     """(0,6)^2, Gamma_D = {0}x(0,6) u {6}x(0,6), Gamma_N = (0,6)x{6}, Gamma_C = (0,6)x{0}."""
-    from ..geometries.rectangle import rectangle, side
+    from damage_dolfinx.geometries.rectangle import rectangle, side
     return rectangle(comm, (0, 0), (6, 6), n, n, {
         GAMMA_D: lambda x: side(0, 0.0)(x) | side(0, 6.0)(x), GAMMA_N: side(1, 6.0),
         GAMMA_C: side(1, 0.0)})
 
 
 def examples():
-    from ..geometries.wrench import wrench
-    from ..problems.fully_damageable_3_3 import FullyDamageableContact
+    from damage_dolfinx.geometries.wrench import wrench
 
     common = [
         "stress eta_*(zeta) A eps(u_t) + eta_*(zeta) Phi_L(B eps(u)), contact pressure "
@@ -87,7 +86,7 @@ def examples():
                        stability_check="off"),
         T=1.0, k=0.01, n=16, diameter=6 * math.sqrt(2),
         make_geometry=lambda comm, n, h: _square(comm, n),
-        make_stepper=FullyDamageableContact,
+        model="3.3",
         traction=lambda x, t: ufl.as_vector((0.0, -10.0 * t)),
         assumptions=common + [
             "thesis data: A = B (m_visc = 1), c_nu = 2e3, E = 100, nu = 0.3, rho = 2700, "
@@ -112,7 +111,7 @@ def examples():
         params=_params(7.1e9, 0.33, 2700.0, 100.0, 1e9, 1e6, math.inf, True, initial_damage="a"),
         T=7.5, k=K_EX2, n=16, diameter=6 * math.sqrt(2),
         make_geometry=lambda comm, n, h: _square(comm, n),
-        make_stepper=FullyDamageableContact,
+        model="3.3",
         traction=lambda x, t: ufl.as_vector((0.0, -2.5e8 * t * ufl.sin(math.pi * t))),
         builders={"zeta0": {"a": zeta0_centre, "b": zeta0_bottom}, "probe": (0.0, 6.0),
                   "profile_x2": {"a": 3.0, "b": 0.0}, "profile_every": 0.5},
@@ -150,7 +149,7 @@ def examples():
                        damage_source_map=True),
         T=6.5, k=K_EX3, h=0.15, diameter=math.hypot(11.2, 2.4),
         make_geometry=lambda comm, n, h: wrench(comm, h=h, h_contact=h / 3),
-        make_stepper=FullyDamageableContact,
+        model="3.3",
         traction=lambda x, t: ufl.as_vector((-1e5 * abs(ufl.sin(math.pi * t)),
                                              -1e5 * abs(ufl.sin(math.pi * t)))),
         assumptions=common + [

@@ -9,9 +9,9 @@ import math
 
 import ufl
 
-from ..examples import Example, Figure
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from ..parameters import ModelParameters
+from damage_dolfinx.catalogue.examples import Example, Figure
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx import ModelParameters
 
 #: 3-D contact examples (issue 17, "3-D: contact" in benchmarks/README.md): default mesh sizes and
 #: time steps; the k of the explicit dynamic schemes is at most 0.8 k_max of stability.py at the
@@ -55,8 +55,7 @@ _3D_COMMON = [
 
 
 def examples():
-    from ..geometries.box_with_hole import box_with_hole
-    from ..problems.elastic_2_1 import ElasticDamage
+    from damage_dolfinx.geometries.box_with_hole import box_with_hole
 
     ex1 = Example(
         id="2.1-ex1-3d", section="2.1",
@@ -66,7 +65,7 @@ def examples():
                                lam_u_plus=1000.0, lam_u_minus=100.0),
         T=1.0, k=0.02, n=10, dim=3, diameter=5 * math.sqrt(3),
         make_geometry=lambda comm, n, h: box_with_hole(comm, n),
-        make_stepper=ElasticDamage,
+        model="2.1",
         body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t, 0.0)),
         assumptions=[
             "issue 17 (beyond the thesis): the 3-D counterpart of 2.1-ex1 with its data "
@@ -88,13 +87,13 @@ def examples():
 
 
 def _box_geometry(L, n, boundary):
-    from ..geometries.box import box
+    from damage_dolfinx.geometries.box import box
     return lambda comm, n_, h: box(comm, (0.0, 0.0, 0.0), (L, L, L), (n_, n_, n_), boundary)
 
 
 def contact_examples():
     """2.3, 3.1 and 3.3 on boxes, and the wrench plate (3.3-ex3-3d)."""
-    from ..geometries.box import face
+    from damage_dolfinx.geometries.box import face
 
     slices = [Figure("fields_slices.png", "", kind="slices")]
 
@@ -165,7 +164,7 @@ def contact_examples():
             "solvers: as in 2-D (velocity CG + Jacobi, mass-dominated; damage obstacle step "
             "SNES vinewtonrsls, CG + Jacobi)"],
         figures=figs("Example 3.3-1 in 3-D: von Mises stress and damage"))
-    from ..geometries.wrench_plate import wrench_plate
+    from damage_dolfinx.geometries.wrench_plate import wrench_plate
     ex3_2d = _thesis_entry("section_3_3", "3.3-ex3")
     ex33w = _from_2d(
         ex3_2d, id="3.3-ex3-3d",

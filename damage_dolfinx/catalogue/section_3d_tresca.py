@@ -13,8 +13,8 @@ import math
 
 import ufl
 
-from ..examples import Figure
-from ..geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.catalogue.examples import Figure
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 #: default cells per side (n x n x n hexahedra, 6 tetrahedra each)
 N_2_2_EX1, N_3_2_EX1 = 8, 8
@@ -37,14 +37,14 @@ _COMMON = [
 
 
 def _unit_cube(comm, n, h):
-    from ..geometries.box import box, face
+    from damage_dolfinx.geometries.box import box, face
     return box(comm, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (n, n, n), {
         GAMMA_C: face(1, 0.0), GAMMA_D: face(0, 0.0), GAMMA_N: face(0, 1.0)})
 
 
 def _cube_gamma_n_left(comm, n, h):
     """3.2-ex1's layout: Gamma_D = {x = 1}, f_N on {x = 0}, Gamma_C = {y = 0}."""
-    from ..geometries.box import box, face
+    from damage_dolfinx.geometries.box import box, face
     return box(comm, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (n, n, n), {
         GAMMA_C: face(1, 0.0), GAMMA_D: face(0, 1.0), GAMMA_N: face(0, 0.0)})
 

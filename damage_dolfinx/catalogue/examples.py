@@ -1,0 +1,240 @@
+"""Catalogue of the thesis examples by id (``2.1-ex1`` ...): data, geometry, scheme, defaults.
+
+Every value the thesis leaves open is an explicit assumption, listed with its PROBLEMS.md gap
+number in the example's ``assumptions`` and copied into each run's summary.json.
+
+Readings (``--reading literal|evidence``, issue 16): ``literal`` is exactly the stated thesis
+data (the catalogue entry itself); ``evidence`` replaces some of it by the values that reproduce
+the thesis results with the fewest departures from the text (:class:`Reading`, each departure an
+assumption R<n> with its thesis lines and the measured evidence). An example without an evidence
+reading has evidence = literal. ``Example.default_reading`` says which one runs by default.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Optional
+
+from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
+from damage_dolfinx.models.base import ProblemData
+
+
+@dataclass
+class Figure:
+    """A PNG written at the end of a run: fields on the deformed configuration."""
+    filename: str
+    title: str
+    fields: tuple = ("von_mises", "zeta")
+    amplification: Optional[float] = None  # None: largest displacement = 10% of diameter (G40)
+    kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh),
+    #                                        "history" (fields = ((column, label), ...) of history.csv)
+    #                                        or "profiles" (summary "profiles" + zeta_probe, 3.3-ex2)
+    #                                        or "slices" (3-D: sections through the body, slices.py)
+    times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
+    mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
+
+
+#: more time steps than this need the parameter allow_long (--allow-long)
+MAX_STEPS = 10_000_000
+
+#: the readings of the thesis data (``--reading``)
+READINGS = ("literal", "evidence")
+
+
+@dataclass
+class Reading:
+    """Departures of one reading from the stated data: parameter values, loads, and the
+    assumptions (thesis lines, measured evidence) that justify them."""
+    overrides: dict = field(default_factory=dict)
+    traction: Optional[Callable] = None
+    body_force: Optional[Callable] = None
+    assumptions: list = field(default_factory=list)
+
+
+@dataclass
+class Example:
+    id: str
+    title: str
+    section: str
+    params: ModelParameters
+    T: float
+    k: float
+    make_geometry: Callable          # (comm, n, h) -> Geometry
+    model: str                       # the model id (models/registry.py: "2.1" ... "3.3")
+    diameter: float
+    n: Optional[int] = None          # structured meshes: cells per side
+    h: Optional[float] = None        # gmsh meshes: element size
+    dim: int = 2                     # space dimension of the mesh (3: the issue-17 examples)
+    body_force: Optional[Callable] = None
+    traction: Optional[Callable] = None
+    zeta0: object = 1.0
+    assumptions: list = field(default_factory=list)
+    figures: list = field(default_factory=list)
+    convergence: Optional[dict] = None  # default study {ref_n, ref_k, n: [...], k: [...]}
+    builders: dict = field(default_factory=dict)  # problem-specific builders (ProblemData)
+    readings: dict = field(default_factory=dict)  # {"evidence": Reading} (literal = the data)
+    default_reading: str = "literal"
+    reading: Optional[str] = None                 # the reading applied (None: the raw entry)
+    literal: Optional["Example"] = field(default=None, repr=False, compare=False)
+    damage_law: Optional[object] = None           # laws.DamageLaw (None: the thesis law)
+    irreversible: bool = False                    # zeta_n <= zeta_{n-1}
+    boundaries: Optional[dict] = None             # role -> tags (None: tags 1, 2, 3 as they are)
+    own: bool = False                             # an own problem (Problem), not the catalogue
+    allow_unstable: bool = False                  # a k above k_max: a warning, not a refusal
+
+    def with_reading(self, name=None) -> "Example":
+        """This example under reading ``name`` (None: the default); raises InputError."""
+        name = name or self.default_reading
+        if name not in READINGS:
+            raise InputError(f"unknown reading {name!r}; known: {', '.join(READINGS)}")
+        base = self.literal or self
+        r = base.readings.get(name, Reading()) if name != "literal" else Reading()
+        label = "the default" if name == base.default_reading else "not the default"
+        departures = (f"{len(r.assumptions)} departure(s) from the stated data, listed as R-entries"
+                      if r.assumptions else "no departure from the stated data")
+        return dataclasses.replace(
+            base, params=base.params.replace(**r.overrides),
+            traction=r.traction or base.traction, body_force=r.body_force or base.body_force,
+            assumptions=[f"reading: {name} ({label}; {departures})"] + base.assumptions
+            + r.assumptions, reading=name, literal=base)
+
+    def _resolved(self, overrides):
+        """(example under the reading named in ``overrides``, overrides without it)."""
+        overrides = dict(overrides or {})
+        name = overrides.pop("reading", None)
+        if self.reading is None or (name is not None and name != self.reading):
+            return self.with_reading(name), overrides
+        return self, overrides
+
+    def configure(self, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+                  comm=None):
+        """Validated (params, time grid, n, h, mesh_file) for a run; raises InputError.
+        ``overrides`` may name the reading (key ``reading``). ``comm``: the ranks of the run
+        (default all), which the memory check is collective on."""
+        ex, overrides = self._resolved(overrides)
+        if ex is not self:
+            return ex.configure(n, k, T, h, overrides, mesh_file, comm)
+        overrides = dict(overrides or {})
+        allow_long = bool(overrides.pop("allow_long", False))
+        from damage_dolfinx.models.registry import model as model_info, quasistatic_k_max
+        info = model_info(self.model)
+        # a time step you choose above k_max is refused (stability_check = error) unless the
+        # check is set explicitly (--allow-unstable sets warn); the thesis's own steps (defaults,
+        # convergence tables) run as the thesis ran them, with a warning above k_max
+        action = overrides.pop("stability_check", None) \
+            if "stability_check" not in self.params.extra else overrides.get("stability_check")
+        if action is None:
+            action = "error" if (k is not None or self.own) and not self.allow_unstable \
+                else "warn"
+            if "stability_check" in self.params.extra and k is not None:
+                overrides["stability_check"] = action
+        from damage_dolfinx.models.registry import validate
+        params = validate(info.id, self.params.replace(**overrides))
+        T = self.T if T is None else float(T)
+        k = self.default_k(n, h, T, params) if k is None else float(k)
+        time = TimeGrid(k, T)
+        k_max = quasistatic_k_max(info.id, params)
+        if k > k_max:
+            from damage_dolfinx.numerics.stability import check_time_step
+            check_time_step(k, k_max, f"{info.explicit}, model {info.id}", action=action)
+        if n is not None and self.n is None:
+            raise InputError(f"example {self.id} uses a gmsh mesh: set its size with --h, not --n")
+        if h is not None and self.h is None:
+            raise InputError(f"example {self.id} uses a structured mesh: set it with --n, not --h")
+        n = self.n if n is None else int(n)
+        h = self.h if h is None else float(h)
+        if n is not None and n < 1:
+            raise InputError(f"number of cells per side n must be >= 1, got n = {n}")
+        if h is not None and not h > 0:
+            raise InputError(f"mesh size h must be positive, got h = {h}")
+        if mesh_file is not None and not Path(mesh_file).is_file():
+            raise InputError(f"mesh file {str(mesh_file)!r} does not exist")
+        if time.num_steps > MAX_STEPS and not allow_long:
+            raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
+                             f"{MAX_STEPS:.0e}; choose a larger k, or --allow-long")
+        if mesh_file is None and not self.own:
+            from mpi4py import MPI
+            from damage_dolfinx.runtime.resources import check_memory
+            # a mesh that cannot fit is refused now (collective on the run's ranks: a serial
+            # cell of a convergence study is built on one rank alone)
+            check_memory(self, n, h, comm or MPI.COMM_WORLD)
+        return params, time, n, h, mesh_file
+
+    def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None):
+        """Mesh, data and time stepper of one run (after validation)."""
+        ex, overrides = self._resolved(overrides)
+        if ex is not self:
+            return ex.build(comm, n, k, T, h, overrides, mesh_file)
+        params, time, n, h, mesh_file = self.configure(n, k, T, h, overrides, mesh_file, comm)
+        from damage_dolfinx.meshes import read_mesh, retag
+        if mesh_file is not None:
+            geometry = read_mesh(mesh_file, comm, self.dim)
+            required = self.required_tags(comm)
+        else:
+            geometry = self.make_geometry(comm, n, h)
+            required = None
+        geometry = retag(geometry, self.boundaries, required, self.model)
+        data = ProblemData(self.id, geometry, params, time, self.body_force, self.traction,
+                           self.zeta0, self.builders, self.damage_law, self.irreversible)
+        from damage_dolfinx.models.registry import model as model_info
+        return model_info(self.model).stepper_class()(data)
+
+    def default_k(self, n, h, T, params) -> float:
+        """The default time step at mesh (n, h) and final time T: the example's k, made smaller
+        in proportion to the cell size on meshes finer than the default for the dynamic models
+        (their k_max is proportional to h), kept below 0.8 k_max for the quasistatic ones with an
+        explicit term, and made to divide T (k = T/N, N the smallest count with k below that)."""
+        from damage_dolfinx.models.registry import quasistatic_k_max
+        k, scaled = self.k, False
+        if self.model.startswith("3."):
+            if n is not None and self.n and n > self.n:
+                k, scaled = k * self.n / n, True
+            if h is not None and self.h and h < self.h:
+                k, scaled = k * h / self.h, True
+        k_max = quasistatic_k_max(self.model, params)
+        if k > 0.8 * k_max:
+            k, scaled = 0.8 * k_max, True
+        ratio = T / k
+        if not scaled and abs(ratio - round(ratio)) <= 1e-8 * max(1.0, ratio):
+            return self.k  # the example's own k, bit for bit
+        return T / math.ceil(ratio * (1 - 1e-12))
+
+    def required_tags(self, comm) -> dict:
+        """role -> tag of every boundary part the example's own mesh has (a mesh file given for
+        the example must have them too)."""
+        from mpi4py import MPI
+        from damage_dolfinx.meshes import tag_counts
+        from damage_dolfinx.models.registry import CLAMPED, TRACTION, CONTACT
+        own = self.make_geometry(MPI.COMM_SELF, self.n, self.h) if comm.rank == 0 else None
+        present = comm.bcast(tag_counts(own) if own is not None else None, root=0)
+        names = {CLAMPED: "clamped (Gamma_D)", TRACTION: "traction (Gamma_N)",
+                 CONTACT: "contact (Gamma_C)"}
+        return {names[t]: t for t in (CLAMPED, TRACTION, CONTACT) if present.get(t)}
+
+
+#: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
+SECTIONS = ["section_2_1", "section_2_2", "section_2_3", "bridge", "section_2_4", "section_3_1",
+            "section_3_2", "section_3_3", "section_3d", "section_3d_tresca"]
+
+
+def catalogue(reading=None) -> dict:
+    """All examples by id, in section order, under ``reading`` (None: each one's default)."""
+    import importlib
+    out = {}
+    for name in SECTIONS:
+        module = importlib.import_module(f"{__package__}.{name}")
+        out.update({ex.id: ex.with_reading(reading) for ex in module.examples()})
+    return out
+
+
+def get(example_id: str, reading=None) -> Example:
+    """The example under ``reading`` (None: its default reading)."""
+    if reading is not None and reading not in READINGS:
+        raise InputError(f"unknown reading {reading!r}; known: {', '.join(READINGS)}")
+    examples = catalogue(reading)
+    if example_id not in examples:
+        raise InputError(f"unknown example id {example_id!r}; known ids: {', '.join(examples)} "
+                         f"(see `damage-dolfinx list`)")
+    return examples[example_id]

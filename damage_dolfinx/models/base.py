@@ -1,0 +1,220 @@
+"""What every problem's time stepper shares: data, state, scalars for the history."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional, Union
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from damage_dolfinx import compat
+from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
+from damage_dolfinx.numerics.solvers import SolveContext
+
+#: a load builder: (x = SpatialCoordinate, t = fem.Constant) -> UFL vector
+LoadBuilder = Callable[[object, object], object]
+
+
+@dataclass
+class ProblemData:
+    """Everything a stepper needs: the example's geometry, data and time grid."""
+    example_id: str
+    geometry: object
+    params: ModelParameters
+    time: TimeGrid
+    body_force: Optional[LoadBuilder] = None
+    traction: Optional[LoadBuilder] = None
+    zeta0: Union[float, Callable] = 1.0
+    builders: dict = field(default_factory=dict)  # problem-specific UFL builders, e.g. g(x)
+    damage_law: Optional[object] = None  # laws.DamageLaw (None: the thesis law of params.variant)
+    irreversible: bool = False           # zeta_n <= zeta_{n-1} (the damage step's upper bound)
+
+
+class TimeStepper:
+    """Base of the schemes: holds the time level, the solve context and common scalars.
+
+    Subclasses create ``self.u`` (displacement), ``self.zeta`` (damage) and ``self.von_mises``
+    (DG0), implement ``_initial_state()`` (t = 0), ``_advance()`` (one step t_{n-1} -> t_n,
+    returning a dict of iteration counts) and ``update_output()``, and list output fields in
+    ``self.output_fields``. Hooks for problem-specific output: ``extra_history_columns`` (keys
+    that ``scalars()`` or the step stats add to history.csv) and ``summary_extra()`` (keys added
+    to summary.json).
+    """
+
+    extra_history_columns: list = []
+
+    def __init__(self, data: ProblemData):
+        self.data, self.params = data, data.params
+        self.mesh = data.geometry.mesh
+        self.comm = self.mesh.comm
+        self.context = SolveContext(example=data.example_id)
+        self.n, self.t = 0, 0.0
+        self.t_const = fem.Constant(self.mesh, 0.0)
+        self.output_fields = []
+
+    @property
+    def error_components(self) -> list:
+        """(name, Function, norm) summed in convergence errors; norm "V" = ||eps(.)||_L2 or
+        "L2". Default: ||u||_V + ||zeta||_Y (Cor. 2.1); problems assign their own."""
+        return getattr(self, "_error_components", None) or [("u", self.u, "V"),
+                                                             ("zeta", self.zeta, "L2")]
+
+    @error_components.setter
+    def error_components(self, components):
+        self._error_components = list(components)
+
+    # -- checkpoint/restart (checkpoint.py)
+    #: steppers whose state is more than Functions (e.g. the bridge's failure record) set False
+    checkpoint_supported = True
+
+    def checkpoint_state(self) -> dict:
+        """name -> Function: everything the next step reads (u, zeta, and v, sigma, ... where
+        the scheme has them). Steppers with more state extend this."""
+        state = {"u": self.u, "zeta": self.zeta}
+        for name in ("v", "w", "sigma"):
+            if isinstance(getattr(self, name, None), fem.Function):
+                state[name] = getattr(self, name)
+        return state
+
+    def restore(self, n: int):
+        """Continue from time level n after checkpoint.load() has set checkpoint_state()."""
+        self._set_time(n)
+
+    # -- time loop interface
+    def initialize(self) -> dict:
+        self._set_time(0)
+        return self._initial_state()
+
+    def advance(self) -> dict:
+        self._set_time(self.n + 1)
+        return self._advance()
+
+    def _set_time(self, n):
+        self.n, self.t = n, self.data.time.t(n)
+        self.t_const.value = self.t
+        self.context.step, self.context.t = n, self.t
+
+    @property
+    def num_steps(self) -> int:
+        return self.data.time.num_steps
+
+    def stop_reason(self) -> Optional[str]:
+        """Why the run must stop early (G43), or None."""
+        if self.params.stop_at_zeta_star and self.zeta_min() <= self.params.zeta_star:
+            return "zeta_star_reached"
+        return None
+
+    # -- helpers for subclasses
+    def obstacle_damage_step(self, prefix="damage_"):
+        """The damage inclusion step of 2.2, 2.4 and 3.1-3.3 (PROBLEMS.md 1.4): zeta_n in K^h from
+        zeta_{n-1} and the explicit source phi(eps(u_{n-1}), zeta_{n-1}), SNES vinewtonrsls.
+        Needs ``self.u_old``, ``self.zeta`` and ``self.zeta_old``."""
+        from damage_dolfinx.numerics.damage import DamageStep
+        p, msh = self.params, self.mesh
+        phi_old = self.damage_source(eps(self.u_old), self.zeta_old)
+        return DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.data.time.k),
+                          fem.Constant(msh, float(p.kappa)), self.context, obstacle=True,
+                          zeta_star=p.zeta_star, prefix=prefix,
+                          irreversible=self.data.irreversible)
+
+    def damage_source(self, e, z):
+        """The damage source phi(e, z) of this run: the user's law, or the thesis law (1.3) or
+        (1.4) of ``params.variant``."""
+        from damage_dolfinx.laws import thesis_law
+        law = self.data.damage_law or thesis_law(self.params.variant)
+        return law(e, z, self.params)
+
+    def _timed(self, key, fn, *args):
+        """fn(*args), its wall time added to self.timings[key]."""
+        start = time.perf_counter()
+        out = fn(*args)
+        self.timings[key] += time.perf_counter() - start
+        return out
+
+    def interpolate_zeta0(self, zeta):
+        z0 = self.data.zeta0
+        if callable(z0):
+            compat.interpolate(zeta, z0)
+        else:
+            zeta.x.array[:] = float(z0)
+        owned = zeta.x.array[:zeta.function_space.dofmap.index_map.size_local]
+        lo = self.comm.allreduce(owned.min() if owned.size else np.inf, op=MPI.MIN)
+        hi = self.comm.allreduce(owned.max() if owned.size else -np.inf, op=MPI.MAX)
+        if lo < self.params.zeta_star - 1e-12 or hi > 1.0 + 1e-12:
+            raise InputError(f"initial damage must lie in [zeta_star, 1] = [{self.params.zeta_star}, 1]; "
+                             f"got values in [{lo:.4g}, {hi:.4g}]")
+
+    def loads(self):
+        """(f_B, f_N) as UFL expressions of x and the time constant (None where absent)."""
+        x = ufl.SpatialCoordinate(self.mesh)
+        f_B = self.data.body_force(x, self.t_const) if self.data.body_force else None
+        f_N = self.data.traction(x, self.t_const) if self.data.traction else None
+        return f_B, f_N
+
+    # -- scalars
+    def zeta_min(self) -> float:
+        owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
+        return self.comm.allreduce(owned.min() if owned.size else np.inf, op=MPI.MIN)
+
+    def zeta_max(self) -> float:
+        owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
+        return self.comm.allreduce(owned.max() if owned.size else -np.inf, op=MPI.MAX)
+
+    def scalars(self) -> dict:
+        """||u||_L2, ||eps(u)||_L2, min/max/mean zeta (the summary.json 'final' block), from
+        matrices assembled once: u^T M u, u^T K_eps u and m . zeta with m_i = int phi_i (exact
+        for P1 fields; no assembly per step)."""
+        if not hasattr(self, "_norm_operators"):
+            self._norm_operators = self._assemble_norm_operators()
+        M, K, m, area, y = self._norm_operators
+        u = compat.petsc_vec(self.u)
+        M.mult(u, y)
+        u_L2_sq = u.dot(y)
+        K.mult(u, y)
+        eps_sq = u.dot(y)
+        zeta_integral = m.dot(compat.petsc_vec(self.zeta))
+        return {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
+                "zeta_min": float(self.zeta_min()), "zeta_max": float(self.zeta_max()),
+                "zeta_mean": float(zeta_integral / area)}
+
+    def _assemble_norm_operators(self):
+        V, Z = self.u.function_space, self.zeta.function_space
+        du, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+        forms = [compat.form(ufl.inner(du, w) * ufl.dx),
+                 compat.form(ufl.inner(eps(du), eps(w)) * ufl.dx)]
+        mats = []
+        for a in forms:
+            A = compat.create_matrix(a)
+            compat.assemble_matrix(A, a, [])
+            A.assemble()
+            mats.append(A)
+        m_form = compat.form(ufl.TestFunction(Z) * ufl.dx)
+        m = compat.create_vector(m_form)
+        with m.localForm() as ml:
+            ml.set(0.0)
+        compat.assemble_vector(m, m_form)
+        m.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        return (*mats, m, m.sum(), mats[0].createVecLeft())
+
+    def iteration_totals(self) -> dict:
+        return {}
+
+    def summary_extra(self) -> dict:
+        """Problem-specific summary.json keys (e.g. a failure load); none by default."""
+        return {}
+
+    def mesh_info(self) -> dict:
+        tdim = self.mesh.topology.dim
+        info = {"cells": self.mesh.topology.index_map(tdim).size_global,
+                "vertices": self.mesh.topology.index_map(0).size_global,
+                "h": self.data.geometry.h, "description": self.data.geometry.description}
+        for name, f in (("u", getattr(self, "u", None)), ("zeta", getattr(self, "zeta", None))):
+            if f is not None:
+                V = f.function_space
+                info[f"dofs_{name}"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
+        return info

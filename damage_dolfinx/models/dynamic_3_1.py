@@ -1,0 +1,183 @@
+"""Section 3.1: dynamic Kelvin-Voigt body, frictionless normal compliance, damage by the obstacle
+inclusion (variant A), scheme (3.48)-(3.51):
+
+    (1) zeta_n in K^h:  (zeta_n - zeta_{n-1}, xi - zeta_n) + k kappa (grad zeta_n, grad(xi - zeta_n))
+                        >= k (phi_A(eps(u_{n-1}), zeta_{n-1}), xi - zeta_n)      (3.49), SNES vinewtonrsls
+    (2) v_n in V^h:     (rho (v_n - v_{n-1})/k, w) + (A eps(v_n), eps(w))
+                        = L_n(w) - (zeta_{n-1} Phi_L(B eps(u_{n-1})), eps(w))
+                          - int_{Gamma_C} c_nu (u_{n-1}.nu - gap)_+ w.nu ds        (3.48), linear
+    (3) u_n = u_{n-1} + k v_n                                                    (3.51)
+
+V = {v = 0 on Gamma_D}; u_0 = v_0 = 0, zeta_0 from the example. The matrix of (2) does not change
+for a fixed k: it is factorised once (prefix ``mech_``), each step assembles a right-hand
+side. It is SPD (the Dirichlet rows are identity rows), so serially it is factorised by PETSc's
+own Cholesky (solvers.serial_cholesky; issue 18: 3.1-ex1 at n = 255, 131k dofs, velocity step
+90 -> 41 ms; at n = 45, 4k dofs, 2.8 -> 1.3 ms) and by MUMPS LU in parallel. The dimension comes
+from the mesh (issue 17): on 3-D meshes with at least
+``VELOCITY_DIRECT_MAX_DOFS_3D`` unknowns the velocity system is solved by CG + GAMG with the
+rigid-body near-nullspace (AMG set up once, CG started from v_{n-1}) instead.
+Damage prefix ``damage_``. Parameters in ``extra``: rho, m_visc, c_nu, gap,
+``damage_active`` (False: zeta frozen at zeta_0 and step (1) skipped, Example 3's undamaged run)
+``stability_check`` (warn | error | off: k against the limit of the explicit elastic and
+contact forces, stability.py, PROBLEMS.md 1.8) and ``error_norm`` (velocity: convergence errors
+in the norm of Cor. 3.1, ||v||_L2 + ||zeta||_L2 (G27); displacement: ||eps(u)||_L2 +
+||zeta||_L2).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+
+from damage_dolfinx import compat
+from damage_dolfinx.numerics import scalable
+from damage_dolfinx.numerics.boundary import clamped
+from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
+from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
+from damage_dolfinx.models.base import ProblemData, TimeStepper
+
+
+#: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
+#: scalable.py's rule; measured (benchmarks/README.md "3-D: contact"): for 100 steps the two break
+#: even at 6591 unknowns, the factorisation costs 55 s at 46 875 (GAMG ahead), its solves stay
+#: ~2x cheaper (long runs on mid-size meshes: -mech_ksp_type preonly -mech_pc_type lu)
+VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
+
+
+class DynamicKelvinVoigt(TimeStepper):
+    """Problem VP^{hk} of Section 3.1."""
+
+    extra_history_columns = ["v_L2", "u_max", "penetration_rms"]
+
+    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+        super().__init__(data)
+        p, msh, x = self.params, self.mesh, data.params.extra
+        V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+        self.u, self.u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
+        self.v, self.v_old = fem.Function(V, name="v"), fem.Function(V, name="v_old")
+        self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
+        self.k = data.time.k
+        self.rho, self.m_visc = float(x["rho"]), float(x["m_visc"])
+        self.c_nu, self.gap = float(x["c_nu"]), float(x.get("gap", 0.0))
+        self.damage_active = bool(x.get("damage_active", True))
+        # G27: ||v||_H + ||zeta||_Y (Cor. 3.1); displacement: ||u||_V + ||zeta||_Y;
+        # velocity_only: ||v||_H (issue 16, the reading that reproduces Table 3.1's magnitude)
+        self.error_components = {
+            "velocity": [("v", self.v, "L2"), ("zeta", self.zeta, "L2")],
+            "displacement": [("u", self.u, "V"), ("zeta", self.zeta, "L2")],
+            "velocity_only": [("v", self.v, "L2")]}[x.get("error_norm", "velocity")]
+
+        # (3.49): damage obstacle step, explicit source
+        self.damage = None
+        if self.damage_active:
+            self.damage = self.obstacle_damage_step(damage_prefix)
+
+        # (3.48): velocity, a constant matrix
+        tags = data.geometry.facet_tags
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+        self.n_facet = ufl.FacetNormal(msh)
+        self.has_contact = self.comm.allreduce(int(np.sum(tags.values == GAMMA_C)), op=MPI.SUM) > 0
+        f_B, f_N = self.loads()
+        const = lambda value: fem.Constant(msh, float(value))  # noqa: E731
+        a, l = velocity_step_forms(ufl.TrialFunction(V), ufl.TestFunction(V), self.v_old,
+                                   self.u_old, self.zeta_old, const(self.rho), const(self.k), p.E,
+                                   p.nu, self.m_visc, p.L_trunc, const(self.c_nu),
+                                   const(self.gap), self.n_facet, f_B, f_N, ds(GAMMA_N),
+                                   ds(GAMMA_C) if self.has_contact else None)
+        self.bcs = [clamped(V, tags, GAMMA_D)]
+        amg = msh.topology.dim == 3 and scalable.global_dofs(V) >= VELOCITY_DIRECT_MAX_DOFS_3D
+        self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context, constant_matrix=True,
+                                 defaults=scalable.MECH_AMG if amg else
+                                 serial_cholesky(msh.comm, DIRECT))
+        scalable.prepare_mech(self.mech, V)  # 3-D: near-nullspace, warm start; 2-D: nothing
+        self.stability = self._stability_check(V, x, ds(GAMMA_C))
+
+        # output: von Mises of the total stress and of the strain (PROBLEMS.md 1.9), DG0
+        Q = compat.scalar_dg0(msh)
+        self.von_mises = fem.Function(Q, name="von_mises")
+        self.von_mises_strain = fem.Function(Q, name="von_mises_strain")
+        sigma = total_stress(self.v, self.u, self.zeta, p.E, p.nu, self.m_visc, p.L_trunc)
+        self._vm_expr = compat.expression(von_mises(sigma), Q)
+        self._vm_strain_expr = compat.expression(von_mises(eps(self.u)), Q)
+        self.figure_fields = {"von_mises_strain": (self.von_mises_strain,
+                                                   "von Mises norm of the strain [-]")}
+        self._scalar_setup(ds(GAMMA_C))
+        self.output_fields = [self.u, self.v, self.zeta, self.von_mises, self.von_mises_strain]
+        self.timings = {"damage": 0.0, "velocity": 0.0, "stability": self.stability.get("time_s", 0.0)}
+
+    # -- the scheme
+    def _initial_state(self) -> dict:
+        self.interpolate_zeta0(self.zeta)  # u_0 = v_0 = 0
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        return {}
+
+    def _advance(self) -> dict:
+        self.u_old.x.array[:] = self.u.x.array
+        self.v_old.x.array[:] = self.v.x.array
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        damage_its = self._timed("damage", self.damage.solve) if self.damage else 0  # (3.49)
+        mech_its = self._timed("velocity", self.mech.solve, self.v)                   # (3.48)
+        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array            # (3.51)
+        return {"damage_its": damage_its, "mech_its": mech_its}
+
+    def update_output(self):
+        compat.interpolate(self.von_mises, self._vm_expr)
+        compat.interpolate(self.von_mises_strain, self._vm_strain_expr)
+
+    # -- stability of the explicit elastic and contact forces (PROBLEMS.md 1.8)
+    def _stability_check(self, V, x, dsC) -> dict:
+        """k_max of the scheme (undamaged, Gamma_C fully in contact: conservative), compared with
+        k according to ``stability_check``; {} when off."""
+        action = x.get("stability_check", "warn")
+        if action == "off":
+            return {}
+        from damage_dolfinx.numerics.stability import check_time_step, estimate_stability
+        start = time.perf_counter()
+        out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
+                                 c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
+                                 bcs=self.bcs, normal=self.n_facet)
+        out["k_over_k_max"] = check_time_step(self.k, out["k_max"],
+                                              f"example {self.data.example_id}", action=action)
+        out["time_s"] = time.perf_counter() - start
+        return out
+
+    def summary_extra(self) -> dict:
+        if not self.stability:
+            return {}
+        return {"k_max": self.stability["k_max"], "k_over_k_max": self.stability["k_over_k_max"],
+                "stability": self.stability}
+
+    # -- scalars: ||v||_L2, max |u| at the nodes, RMS penetration on Gamma_C
+    def _scalar_setup(self, dsC):
+        self._penetration = compat.form(
+            ufl.max_value(ufl.dot(self.u, self.n_facet) - self.gap, 0.0) ** 2 * dsC)
+        self._contact_length = compat.assemble_scalar(fem.Constant(self.mesh, 1.0) * dsC, self.comm)
+
+    def u_max(self) -> float:
+        """max over the nodes of |u_n| (the L-shape comparison of Example 3)."""
+        owned = self.u.function_space.dofmap.index_map.size_local
+        u = self.u.x.array.reshape(-1, self.mesh.topology.dim)[:owned]
+        return self.comm.allreduce(float(np.linalg.norm(u, axis=1).max()) if owned else 0.0,
+                                   op=MPI.MAX)
+
+    def scalars(self) -> dict:
+        out = super().scalars()
+        M, y = self._norm_operators[0], self._norm_operators[-1]  # v^T M v: no assembly
+        v = compat.petsc_vec(self.v)
+        M.mult(v, y)
+        out["v_L2"] = float(np.sqrt(abs(v.dot(y))))
+        out["u_max"] = self.u_max()
+        length = self._contact_length
+        pen = compat.assemble_scalar(self._penetration, self.comm) if length > 0 else 0.0
+        out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
+        return out
+
+    def iteration_totals(self) -> dict:
+        return {"damage_snes": self.damage.iterations if self.damage else 0,
+                "mech_ksp": self.mech.iterations, "mech_factorizations": self.mech.factorizations}

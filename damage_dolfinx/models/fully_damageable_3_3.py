@@ -1,0 +1,309 @@
+"""Section 3.3: dynamic, fully damageable frictionless contact (damage scales the viscosity, the
+elasticity and the contact pressure), damage by the obstacle inclusion (variant A), scheme
+(3.158)-(3.160):
+
+    (1) zeta_n in K^h:  (zeta_n - zeta_{n-1}, xi - zeta_n) + k kappa (grad zeta_n, grad(xi - zeta_n))
+                        >= k (phi_A(eps(u_{n-1}), eta_*(zeta_{n-1})), xi - zeta_n)
+                                                               (3.158), SNES vinewtonrsls
+    (2) v_n in V^h:     (rho (v_n - v_{n-1})/k, w) + (zeta_n A eps(v_n), eps(w))
+                        = L_n(w) - (zeta_{n-1} Phi_L(B eps(u_{n-1})), eps(w))
+                          - int_{Gamma_C} zeta_{n-1} c_nu (u_{n-1}.nu - gap)_+ w.nu ds
+                                                               (3.159), linear
+    (3) u_n = u_{n-1} + k v_n                                  (3.160)
+
+Order matters: the viscosity of (2) uses the NEW damage zeta_n of (1), so the matrix of (2)
+changes every step; it is re-assembled into the same PETSc Mat and solved by CG + Jacobi (prefix
+``mech_``; the mass rho/k M dominates when m_visc is large, Examples 2-3). V = {v = 0 on
+Gamma_D} (Gamma_D may be empty: the mass keeps (2) definite). u_0 = v_0 = 0.
+
+Parameters in ``extra``: rho, m_visc, c_nu, gap, ``damage_active`` (False: zeta frozen at
+zeta_0), ``stability_check`` (warn | error | off; k against the limit of the explicit elastic
+and contact forces, stability.py, PROBLEMS.md 1.8), ``elastic_term`` = ``explicit`` (the thesis)
+or ``implicit`` (G33 deviation, NOT the thesis scheme: elastic and contact forces at
+u_{n-1} + k v_n, a semismooth Newton solve per step, prefix ``mech_``), ``initial_damage``
+(a key of ``builders["zeta0"]``, Example 2's cases a/b).
+
+Output: von Mises of the total stress zeta_n A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (DG0);
+history columns v_L2, the maximal interpenetration (u.nu - gap)_+ over the Gamma_C vertices and
+its location, and zeta at ``builders["probe"]``; damage profiles along x_2 =
+``builders["profile_x2"]`` every ``builders["profile_every"]`` s (plus the latest state) in
+summary.json. Convergence errors in the norm of Cor. 3.3: ||u||_L2 + ||zeta||_L2.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+
+from damage_dolfinx import compat
+from damage_dolfinx.numerics.boundary import clamped
+from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.fully_damageable import (implicit_velocity_residual, total_stress,
+                                      velocity_matrix_parts, velocity_rhs_boundary,
+                                      velocity_step_forms)
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
+from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
+from damage_dolfinx.numerics.zeta_linear import VelocitySolver
+from damage_dolfinx.models.base import ProblemData, TimeStepper
+
+#: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
+#: VELOCITY_EXTRAPOLATION);
+#: override with -mech_ksp_type / -mech_pc_type (e.g. hypre)
+MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
+                 "ksp_max_it": 5000, "ksp_initial_guess_nonzero": True}
+
+#: issue 18 (per-step cost): the matrix of (3.159) from the nodal zeta_n by a precomputed sparse
+#: map instead of a re-assembly (serial; equal to round-off); with Phi_L = identity the
+#: right-hand side too (FAST_RHS); CG started from the cubic extrapolation
+#: 4 v_{n-1} - 6 v_{n-2} + 4 v_{n-3} - v_{n-4} instead of v_{n-1} (same solution to rtol 1e-12;
+#: wrench, T = 0.05: 15.0 -> 9.1 iterations per step; linear 11.4, quadratic 10.1). Switches for
+#: benchmarks/step_profile_3_3.py, which times the step both ways.
+FAST_MATRIX = True
+FAST_RHS = True
+VELOCITY_EXTRAPOLATION = True
+
+
+class FullyDamageableContact(TimeStepper):
+    """Problem VP^{hk} of Section 3.3."""
+
+    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+        super().__init__(data)
+        p, msh, x = self.params, self.mesh, data.params.extra
+        V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+        self.u, self.u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
+        self.v, self.v_old = fem.Function(V, name="v"), fem.Function(V, name="v_old")
+        # v_{n-3}, v_{n-4} of the CG start's extrapolation (checkpointed: a resume is exact)
+        self._v_older = [fem.Function(V, name=f"v_older{i}") for i in (3, 4)]
+        self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
+        self.k = data.time.k
+        self.rho, self.m_visc = float(x["rho"]), float(x["m_visc"])
+        self.c_nu, self.gap = float(x["c_nu"]), float(x.get("gap", 0.0))
+        self.damage_active = bool(x.get("damage_active", True))
+        self.elastic_term = x.get("elastic_term", "explicit")
+        self.extrapolate = VELOCITY_EXTRAPOLATION
+        self.error_components = [("u", self.u, "L2"), ("zeta", self.zeta, "L2")]  # Cor. 3.3
+
+        # (3.158): damage obstacle step, source phi_A(eps(u_{n-1}), eta_*(zeta_{n-1}))
+        self.damage = None
+        if self.damage_active:
+            self.damage = self.obstacle_damage_step(damage_prefix)
+            # issue 18: ``damage_atol_rel`` (the wrench: 0) replaces the obstacle step's absolute
+            # tolerance 1e-9 ||l|| (damage.OBSTACLE_ATOL_REL) by snes_atol = 1e-12 alone; with
+            # 1e-9 ||l|| a step whose increment has a smaller residual keeps zeta_{n-1}, which
+            # dropped the wrench's damage up to t = 0.3 and in many steps up to t = 1.4
+            rel = x.get("damage_atol_rel")
+            if rel is not None:
+                if not float(rel) >= 0.0:
+                    raise InputError(f"damage_atol_rel must be >= 0, got {rel!r}")
+                self.damage.atol_rel = float(rel)
+            # issue 18: ``damage_source_map`` (the wrench): the damage right-hand side by sparse
+            # maps where the source is constant on every cell (damage.use_cellwise_source; it
+            # checks itself against the assembly and keeps the assembly otherwise)
+            if x.get("damage_source_map"):
+                self.damage.use_cellwise_source(self.u_old, self.params)
+
+        # (3.159): velocity with the new damage in the viscosity
+        tags = data.geometry.facet_tags
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+        self.n_facet = ufl.FacetNormal(msh)
+        f_B, f_N = self.loads()
+        const = lambda value: fem.Constant(msh, float(value))  # noqa: E731
+        args = (self.v_old, self.u_old, self.zeta, self.zeta_old, const(self.rho), const(self.k),
+                p.E, p.nu, self.m_visc, p.L_trunc, p.zeta_star, const(self.c_nu), const(self.gap),
+                self.n_facet, f_B, f_N, ds(GAMMA_N), ds(GAMMA_C))
+        self.bcs = [clamped(V, tags, GAMMA_D)]
+        w = ufl.TestFunction(V)
+        if self.elastic_term == "explicit":
+            a, l = velocity_step_forms(ufl.TrialFunction(V), w, *args)
+            if self.comm.size == 1 and FAST_MATRIX:  # issue 18: no re-assembly per step
+                parts = velocity_matrix_parts(ufl.TrialFunction(V), w, args[4], args[5], p.E,
+                                              p.nu, self.m_visc)
+                rhs = None  # Phi_L = identity: l by the same sparse maps (clamped: g = 0)
+                if FAST_RHS and (p.L_trunc is None or math.isinf(p.L_trunc)):
+                    rhs = (velocity_rhs_boundary(w, self.u_old, self.zeta_old, p.zeta_star,
+                                                 *args[11:]), self.v_old, self.u_old,
+                           self.zeta_old, self.m_visc)
+                self.mech = VelocitySolver(a, l, self.bcs, mech_prefix, self.context, V,
+                                           *parts, self.zeta, rhs, defaults=MECH_DEFAULTS)
+            else:
+                self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context,
+                                         constant_matrix=False, defaults=MECH_DEFAULTS)
+        elif self.elastic_term == "implicit":  # G33 deviation
+            F = implicit_velocity_residual(self.v, w, *args)
+            self.mech = NonlinearSolver(F, self.v, self.bcs, mech_prefix, self.context)
+        else:
+            raise InputError("elastic_term must be 'explicit' or 'implicit', "
+                             f"got {self.elastic_term!r}")
+        self.stability = self._stability_check(V, x, ds(GAMMA_C))
+
+        # output: von Mises of the total stress (PROBLEMS.md 1.9), DG0
+        Q = compat.scalar_dg0(msh)
+        self.von_mises = fem.Function(Q, name="von_mises")
+        sigma = total_stress(self.v, self.u, self.zeta, p.E, p.nu, self.m_visc, p.L_trunc,
+                             p.zeta_star)
+        self._vm_expr = compat.expression(von_mises(sigma), Q)
+        self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
+        self.contact = ContactMonitor(V, tags, GAMMA_C, self.gap)
+        self.probe = ZetaProbe(Z, data.builders.get("probe"))
+        choice = x.get("initial_damage")
+        line = data.builders.get("profile_x2")
+        if isinstance(line, dict):
+            line = line.get(choice)
+        self.profiles = DamageProfiles(Z, line, data.builders.get("profile_every", 0.5), self.k)
+        self.extra_history_columns = (["v_L2"] + self.contact.columns + self.probe.columns)
+        self.timings = {"damage": 0.0, "velocity": 0.0,
+                        "stability": self.stability.get("time_s", 0.0)}
+
+    # -- the scheme
+    def _initial_state(self) -> dict:
+        self._interpolate_zeta0()  # u_0 = v_0 = 0
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        self.profiles.sample(self.zeta, self.t)
+        return {}
+
+    def _advance(self) -> dict:
+        if not hasattr(self, "_arrays"):  # views of the Functions' values (stable; issue 18)
+            self._arrays = [f.x.array for f in (self.u, self.u_old, self.v, self.v_old,
+                                                self.zeta, self.zeta_old, *self._v_older)]
+        u, u_old, v, v_old, zeta, zeta_old, v3, v4 = self._arrays
+        extrapolate = self.extrapolate and self.elastic_term == "explicit"
+        if extrapolate:  # CG start: cubic extrapolation from v_{n-1}, ..., v_{n-4}
+            v_guess = 4.0 * (v + v3) - 6.0 * v_old - v4
+            v4[:] = v3
+            v3[:] = v_old
+        u_old[:] = u
+        v_old[:] = v
+        zeta_old[:] = zeta
+        damage_its = self._timed("damage", self.damage.solve) if self.damage else 0  # (3.158)
+        if self.elastic_term == "explicit":
+            if extrapolate:
+                v[:] = v_guess
+            mech_its = self._timed("velocity", self.mech.solve, self.v)            # (3.159)
+            stats = {"damage_its": damage_its, "mech_its": mech_its}
+        else:
+            snes_its = self._timed("velocity", self.mech.solve)                     # G33
+            stats = {"damage_its": damage_its, "snes_its": snes_its}
+        np.add(u_old, self.k * v, out=u)                                          # (3.160)
+        self.profiles.sample(self.zeta, self.t)
+        return stats
+
+    def checkpoint_state(self) -> dict:
+        """u, zeta, v and, for the CG start's extrapolation, v_{n-2}, v_{n-3}, v_{n-4}: without
+        them a resumed run starts its CG elsewhere and differs at the solver tolerance (2e-11).
+        ``monitors``: what summary.json reports over all steps (the maximal interpenetration,
+        its time and place; the first time the probe reaches zeta_star, NaN: not yet), so that
+        a resumed run reports the maximum over the whole run (collective)."""
+        state = super().checkpoint_state()
+        if self.extrapolate and self.elastic_term == "explicit":
+            state.update(v_old=self.v_old, v_older3=self._v_older[0], v_older4=self._v_older[1])
+        first = self.probe.first_zeta_star_time
+        self._monitors = np.array(self.contact.state() + [math.nan if first is None else first])
+        state["monitors"] = self._monitors
+        return state
+
+    def restore(self, n: int):
+        super().restore(n)
+        *contact, first = self._monitors
+        self.contact.set_state(contact)
+        self.probe.first_zeta_star_time = None if math.isnan(first) else float(first)
+
+    def track(self):
+        """Between history rows (runner, history_every > 1): only what summary.json reports
+        over all steps, the maximal interpenetration and the first time the probe reaches
+        zeta_star (in serial no communication)."""
+        self.contact.track(self.u, self.t)
+        if self.probe.point is not None:
+            self.probe(self.zeta, self.t, self.params.zeta_star)
+
+    def _interpolate_zeta0(self):
+        """Example 2 selects its initial damage with ``--set initial_damage=a|b``."""
+        choices = self.data.builders.get("zeta0")
+        choice = self.params.extra.get("initial_damage")
+        if choices is not None:
+            if choice not in choices:
+                raise InputError(f"initial_damage must be one of {', '.join(choices)}, "
+                                 f"got {choice!r}")
+            self.data.zeta0 = choices[choice]
+        self.interpolate_zeta0(self.zeta)
+
+    def update_output(self):
+        compat.interpolate(self.von_mises, self._vm_expr)
+
+    # -- stability of the explicit elastic and contact forces (PROBLEMS.md 1.8)
+    def _stability_check(self, V, x, dsC) -> dict:
+        """k_max of the explicit scheme (undamaged body, Gamma_C fully in contact: conservative)
+        compared with k according to ``stability_check``; {} when off. The implicit variant
+        (G33) is reported against the same k_max but never warned about."""
+        action = x.get("stability_check", "warn")
+        if action == "off":
+            return {}
+        from damage_dolfinx.numerics.stability import check_time_step, estimate_stability
+        start = time.perf_counter()
+        has_contact = self.comm.allreduce(
+            int(np.sum(self.data.geometry.facet_tags.values == GAMMA_C)), op=MPI.SUM) > 0
+        out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
+                                 c_nu=self.c_nu if has_contact else 0.0, dsC=dsC, bcs=self.bcs,
+                                 normal=self.n_facet)
+        out["k_over_k_max"] = check_time_step(
+            self.k, out["k_max"], f"example {self.data.example_id}",
+            action=action if self.elastic_term == "explicit" else "off")
+        out["time_s"] = time.perf_counter() - start
+        return out
+
+    # -- scalars and summary
+    def scalars(self) -> dict:
+        """The base scalars (the same operations as TimeStepper.scalars, so the same values)
+        plus v_L2, the interpenetration and the probe. The runner asks for them after every
+        step (history.csv), so the vectors and views are cached and the extrema take one
+        Allreduce, none in serial (issue 18: 120 -> 40 us per wrench step)."""
+        if not hasattr(self, "_scalar_cache"):
+            self._norm_operators = self._assemble_norm_operators()
+            owned = self.zeta.function_space.dofmap.index_map.size_local
+            self._scalar_cache = ([compat.petsc_vec(f) for f in (self.u, self.v, self.zeta)],
+                                  self.zeta.x.array[:owned], np.empty(2))
+        M, K, m, area, y = self._norm_operators
+        (u, v, z), owned, ext = self._scalar_cache
+        M.mult(u, y)
+        u_L2_sq = u.dot(y)
+        K.mult(u, y)
+        eps_sq = u.dot(y)
+        M.mult(v, y)
+        v_sq = v.dot(y)
+        zeta_integral = m.dot(z)
+        ext[:] = (-owned.min(), owned.max()) if owned.size else (-np.inf, -np.inf)
+        if self.comm.size > 1:
+            self.comm.Allreduce(MPI.IN_PLACE, ext, op=MPI.MAX)
+        out = {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))),
+               "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
+               "zeta_min": float(-ext[0]), "zeta_max": float(ext[1]),
+               "zeta_mean": float(zeta_integral / area),
+               "v_L2": float(np.sqrt(abs(v_sq)))}  # = ||v||_L2: v^T M v, no assembly
+        out.update(self.contact(self.u, self.t))
+        out.update(self.probe(self.zeta, self.t, self.params.zeta_star))
+        return out
+
+    def summary_extra(self) -> dict:
+        out = {"k": self.k, "elastic_term": self.elastic_term + (
+            "" if self.elastic_term == "explicit" else " (G33 deviation, not the thesis scheme)")}
+        if self.stability:
+            out.update(k_max=self.stability["k_max"], k_over_k_max=self.stability["k_over_k_max"],
+                       stability=self.stability)
+        out.update(self.contact.summary())
+        out.update(self.probe.summary())
+        out.update(self.profiles.summary(self.zeta, self.t))
+        return out
+
+    def iteration_totals(self) -> dict:
+        out = {"damage_snes": self.damage.iterations if self.damage else 0}
+        if self.elastic_term == "explicit":
+            out.update(mech_ksp=self.mech.iterations, mech_solves=self.mech.solves)
+        else:
+            out.update(snes=self.mech.iterations, mech_ksp=self.mech.linear_iterations)
+        return out

@@ -1,0 +1,166 @@
+"""Section 2.3: quasistatic viscoelastic body with long memory, frictionless normal compliance
+and damage (PDE form, variant A), scheme (2.136)-(2.137).
+
+    u_0:  (B eps(u_0), eps(w)) + (p_nu(u_0.nu), w.nu)_{Gamma_C} = L_0(w)      (Remark 2.3, no memory)
+    n>=1: (zeta_n - zeta_{n-1}, xi) + k kappa (grad zeta_n, grad xi) = k (phi_A(eps(u_{n-1}), zeta_{n-1}), xi)
+          M_n = sum_{j=1..n} k G(t_n - t_{j-1}, eps(u_{j-1}), zeta_{j-1})                    (2.136)
+          (B eps(u_n) + M_n, eps(w)) + (p_nu(u_n.nu - gap), w.nu)_{Gamma_C} = L_n(w)         (2.137)
+
+p_nu(r) = c_nu r_+ (semismooth Newton, SNES prefix ``mech_``); damage PDE step prefix
+``damage_`` (matrix factorised once). The dimension comes from the mesh (issue 17): on a 3-D mesh
+B is 3-D Hooke, M_n a 3x3 tensor, Gamma_C any plane or curved face; from
+``scalable.DIRECT_MAX_DOFS_3D`` unknowns on, Newton's linear systems are solved by CG +
+BoomerAMG (``mech_contact_amg``; the AMG set-up lagged like the factorisation in 2-D) and
+the damage PDE by CG + BoomerAMG. The memory term is updated in O(1) per step for constant
+and exponential kernels (memory.py).
+"""
+from __future__ import annotations
+
+
+import numpy as np
+import ufl
+from dolfinx import fem
+
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+
+from damage_dolfinx import compat
+from damage_dolfinx.numerics import scalable
+from damage_dolfinx.numerics.boundary import clamped
+from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.numerics.damage import DamageStep
+from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
+from damage_dolfinx.numerics.cellwise_stress import MemoryIntegrand
+from damage_dolfinx.numerics.memory import MemoryKernel, MemoryTerm
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
+from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
+from damage_dolfinx.models.base import ProblemData, TimeStepper
+
+
+#: Krylov iterations above which the lagged Jacobian factorisation is rebuilt
+MECH_REFACTOR_ITS = 10
+
+
+def mech_contact_amg():
+    """Newton defaults of the 3-D displacement step at size: CG + hypre BoomerAMG (where PETSc
+    has hypre; None otherwise: the lagged direct solve). GAMG, the elasticity default of
+    scalable.py, fails here: with the near-rigid foundation (c_nu = 1e10 against E = 100) its
+    Chebyshev/Jacobi smoother gave an indefinite preconditioner once the contact term was active
+    (2.3-ex1-3d, n = 10 and 20), with SOR smoothing a failed level solve at n = 20; BoomerAMG
+    took 8-14 CG iterations per Newton step at n = 10 and 20 (benchmarks/README.md "3-D:
+    contact")."""
+    return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
+
+
+class ViscoelasticMemoryContact(TimeStepper):
+    """Problem VP^{hk} of Section 2.3."""
+
+    extra_history_columns = ["penetration_rms", "stress_L2"]
+
+    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+        super().__init__(data)
+        p, msh, x = self.params, self.mesh, data.params.extra
+        V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+        self.u = fem.Function(V, name="u")
+        self.zeta = fem.Function(Z, name="zeta")
+        self.zeta_old = fem.Function(Z, name="zeta_old")
+        k = data.time.k
+        self.c_nu, self.gap = float(x["c_nu"]), float(x.get("gap", 0.0))
+
+        # (1.5): damage PDE step with phi_A at step n-1
+        phi_old = self.damage_source(eps(self.u), self.zeta_old)
+        self.damage = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, k),
+                                 fem.Constant(msh, float(p.kappa)), self.context,
+                                 obstacle=False, zeta_star=p.zeta_star, prefix=damage_prefix,
+                                 linear_defaults=scalable.damage_config(Z),
+                                 irreversible=data.irreversible)
+
+        # (2.136): memory, g evaluated at (u_{n-1}, zeta_{n-1}) before u and zeta move on
+        kernel = MemoryKernel(x["memory_kernel"], float(x.get("memory_amplitude", 1.0)),
+                              float(x.get("memory_rate", 1.0)))
+        self.memory = MemoryTerm(msh, kernel, k, x.get("memory_mode", "auto"))
+        self._g_expr = compat.expression(
+            memory_integrand(self.u, self.zeta, p.E, p.nu, p.L_trunc), self.memory.space)
+        # issue 18: g by the cell stress map S u (cellwise_stress.py, checked against the
+        # interpolation at construction; P1 u on simplices): 0.9 ms of 3.8 per step at 4k dofs
+        self._g_map = None
+        if compat.element_degree(V) == 1:
+            try:
+                self._g_map = MemoryIntegrand(self.memory.g, self.u, self.zeta, p.E, p.nu,
+                                              p.L_trunc, self._g_expr)
+            except RuntimeError:  # the map differs from the interpolation: keep the latter
+                pass
+
+        # (2.137): nonlinear displacement step
+        tags = data.geometry.facet_tags
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
+        self.n_facet = ufl.FacetNormal(msh)
+        f_B, f_N = self.loads()
+        F = displacement_residual(self.u, ufl.TestFunction(V), self.memory.M, p.E, p.nu,
+                                  self.c_nu, self.gap, self.n_facet, f_B, f_N, ds(GAMMA_N),
+                                  ds(GAMMA_C))
+        bc = clamped(V, tags, GAMMA_D)
+        if scalable.iterative(V) and mech_contact_amg():  # 3-D at size: CG + BoomerAMG
+            self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
+                                        defaults=mech_contact_amg(),
+                                        refactor_after_its=scalable.MECH_AMG_REBUILD_ITS)
+            J, P = self.mech.snes.snes.getJacobian()[:2]
+            modes = scalable.rigid_body_modes(V)
+            for A in (J, P):
+                A.setNearNullSpace(modes)
+        else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation; the Jacobian
+            # is the constant (B eps(du), eps(w)) plus the Gamma_C term, which alone is
+            # assembled per Newton step (issue 18: 2.3-ex1 at n = 160, 31 ms of 99 per step)
+            self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
+                                        refactor_after_its=MECH_REFACTOR_ITS,
+                                        jacobian_split=constant_cell_jacobian(F, self.u))
+
+        Q = compat.scalar_dg0(msh)
+        self.von_mises = fem.Function(Q, name="von_mises")
+        self._vm_expr = compat.expression(
+            von_mises(total_stress(self.u, self.memory.M, p.E, p.nu)), Q)
+        self._penetration = compat.form(
+            ufl.max_value(ufl.dot(self.u, self.n_facet) - self.gap, 0.0) ** 2 * ds(GAMMA_C))
+        self._contact_length = compat.form(fem.Constant(msh, 1.0) * ds(GAMMA_C))
+        sigma = total_stress(self.u, self.memory.M, p.E, p.nu)
+        self._stress_sq = compat.form(ufl.inner(sigma, sigma) * ufl.dx)
+        self.output_fields = [self.u, self.zeta, self.von_mises]
+        self.timings = {"damage": 0.0, "memory": 0.0, "mech": 0.0}
+
+    def checkpoint_state(self) -> dict:
+        """u, zeta and the memory M_n (running/recursive modes keep no other history)."""
+        if self.memory.mode == "sum":
+            raise InputError("memory mode 'sum' stores the whole history: no checkpoints")
+        return {**super().checkpoint_state(), "memory": self.memory.M}
+
+    def _initial_state(self) -> dict:
+        self.interpolate_zeta0(self.zeta)
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        its = self._timed("mech", self.mech.solve)
+        return {"mech_its": its}
+
+    def _advance(self) -> dict:
+        self._timed("memory", self.memory.update, self._g_map or self._g_expr)  # u_{n-1}, zeta_{n-1}
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        damage_its = self._timed("damage", self.damage.solve)
+        mech_its = self._timed("mech", self.mech.solve)
+        return {"damage_its": damage_its, "snes_its": mech_its}
+
+    def update_output(self):
+        compat.interpolate(self.von_mises, self._vm_expr)
+
+    def scalars(self) -> dict:
+        """Base scalars, the RMS penetration (u.nu - gap)_+ over Gamma_C and ||sigma_n||_Q."""
+        out = super().scalars()
+        out["stress_L2"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
+        if not isinstance(self._contact_length, float):  # |Gamma_C|, assembled once
+            self._contact_length = compat.assemble_scalar(self._contact_length, self.comm)
+        length = self._contact_length
+        pen = compat.assemble_scalar(self._penetration, self.comm)
+        out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
+        return out
+
+    def iteration_totals(self) -> dict:
+        return {"damage_ksp": self.damage.iterations, "snes": self.mech.iterations,
+                "mech_ksp": self.mech.linear_iterations,
+                "mech_factorizations": self.mech.factorizations}

@@ -1,0 +1,95 @@
+"""Second-kind variational inequalities with Tresca friction (velocity step (2.67), increment
+step (2.187), dynamic step (3.94)): three interchangeable solvers of the same discrete problem
+
+    v in V:  a(v, w - v) + j(w) - j(v) >= l(w - v)  for all w in V,
+    j(w) = sum_i m_i g_i |w_tau,i|   (nodal quadrature of int_{Gamma_C} g |w_tau| ds),
+
+where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet conditions).
+
+* :class:`RegularisedNewton` (the main solver): SNES Newton on the regularised law Phi_eps
+  (2.99)-(2.101) with a backtracking line search on the convex energy
+  1/2 a(v,v) - l(v) + j_eps(v) (SNES objective), warm start from the previous step at the target
+  eps_reg (1e-9). Each step first tries full Newton steps, then the primal-dual active-set
+  iteration on the same equations (:class:`PrimalDualActiveSet`, for steps that reverse the
+  slip), then the line search; further fallbacks: an eps continuation (1e-2, 1e-3, ..., target), then the same
+  continuation with a Jacobian shift (needed when no Gamma_D holds the body). The residual is
+  algebraic (:class:`AlgebraicResidual`: one matrix-vector product per iteration, no assembly);
+  linear solves by Cholesky (PETSc's in serial, MUMPS in parallel), re-factorised only when the
+  Jacobian changes (i.e. when the stick set changes).
+* :class:`Uzawa` (2.98) with the corrections of G8: lambda_{s+1} = P(lambda_s + rho g v_tau),
+  P(x) = x / max(1, |x|); the unregularised problem (needs Gamma_D: a must be coercive).
+* :class:`PenaltyDuality`: the Bermudez-Moreno iteration on the regularised problem, as in the
+  thesis: Phi_eps(v_tau) = omega v_tau + q, q_{s+1} = (G - omega I)_lambda(v_tau + lambda q_s),
+  lambda omega = 1/2.
+
+Uzawa and penalty-duality factorise their constant matrix once and update nodal multipliers
+with NumPy (no loops over dofs); both stop when ||v_{s+1} - v_s||_V <= tol ||v_{s+1}||_V
+(thesis: tol = 1e-6).
+
+3-D (issue 17): the same four iterations with a 2-D tangent plane, w_tau a 2-vector per node
+(two coordinate-axis tangents; Gamma_C made of faces parallel to coordinate planes, others are
+refused), |w_tau| its Euclidean norm: Phi_eps(s) = g s / max(|s|, eps) (in 2-D this is
+g max(-1, min(1, s/eps)), (2.99)), Newton's Jacobian blocks m g/eps I (stick) and
+m g/|s| (I - s s^T/|s|^2) (slip), 2-vector multipliers in the active-set iteration, Uzawa's
+projection onto the disc of radius 1, penalty-duality's resolvent along s/|s| (``law``).
+The 2-D code paths are unchanged (2-D results identical bit for bit).
+
+Modules: ``nodes`` (FrictionProblem, ContactNodes), ``law`` (the nodal law in NumPy),
+``residual`` (AlgebraicResidual), ``active_set`` (PrimalDualActiveSet), ``newton``
+(RegularisedNewton), ``baselines`` (Uzawa, PenaltyDuality); here the selection by parameters.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.numerics.friction import law
+from damage_dolfinx.numerics.friction.active_set import PrimalDualActiveSet
+from damage_dolfinx.numerics.friction.baselines import ConstantOperator, PenaltyDuality, Uzawa
+from damage_dolfinx.numerics.friction.newton import (FAST_MAX_IT, FAST_PAUSE_STEPS, FRICTION_NEWTON, PDAS_MAX_IT, REFACTOR_ITS,
+                     RegularisedNewton)
+from damage_dolfinx.numerics.friction.nodes import JACOBIAN_SHIFT, ContactNodes, FrictionProblem
+from damage_dolfinx.numerics.friction.residual import AlgebraicResidual
+
+__all__ = ["law", "AlgebraicResidual", "ConstantOperator", "ContactNodes", "FAST_MAX_IT",
+           "FAST_PAUSE_STEPS", "FRICTION_NEWTON", "FrictionProblem", "JACOBIAN_SHIFT",
+           "PDAS_MAX_IT", "PenaltyDuality", "PrimalDualActiveSet", "REFACTOR_ITS",
+           "RegularisedNewton", "SOLVERS", "Uzawa", "iteration_counters", "make_solver",
+           "solver_from_parameters"]
+
+SOLVERS = ("newton", "uzawa", "penalty-duality")
+
+
+def iteration_counters(solver) -> dict:
+    """The friction solver's fallback counters for summary.json (zeros for Uzawa and PD)."""
+    return {f"friction_{name}": getattr(solver, name, 0)
+            for name in ("continuations", "shifted_continuations", "full_step_solves",
+                         "pdas_solves", "pdas_iterations", "pdas_failures")}
+
+
+def solver_from_parameters(problem: FrictionProblem, extra: dict, facet_tags, gamma_D: int,
+                           example_id: str):
+    """The solver named by ``extra["friction_solver"]`` with its parameters from ``extra``
+    (eps_reg, rho_uzawa, omega_pd, friction_tol). Uzawa is refused without a clamped part
+    Gamma_D: its operator is then singular (quasistatic) or its ||eps(v)|| stopping test cannot
+    see rigid motions (dynamic)."""
+    kind = extra["friction_solver"]
+    comm = problem.msh.comm
+    if kind == "uzawa" and comm.allreduce(int(np.sum(facet_tags.values == gamma_D))) == 0:
+        raise InputError(f"{example_id}: the Uzawa friction solver needs a clamped part Gamma_D "
+                         "(without it its operator is singular or its ||eps(v)|| stopping test "
+                         "cannot see rigid motions); use newton or penalty-duality")
+    return make_solver(kind, problem, extra["eps_reg"], extra.get("rho_uzawa", 1.0),
+                       extra.get("omega_pd", 100.0), extra.get("friction_tol", 1e-6))
+
+
+def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: float,
+                omega_pd: float, tol: float = 1e-6):
+    """The friction solver selected by ``kind`` (newton | uzawa | penalty-duality)."""
+    if kind == "newton":
+        return RegularisedNewton(problem, eps_reg)
+    if kind == "uzawa":
+        return Uzawa(problem, rho_uzawa, tol=tol)
+    if kind == "penalty-duality":
+        return PenaltyDuality(problem, eps_reg, omega_pd, tol=tol)
+    raise InputError(f"unknown friction solver {kind!r}; choose one of {', '.join(SOLVERS)}")

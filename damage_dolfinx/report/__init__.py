@@ -1,0 +1,1 @@
+"""The thesis reproduction: figure and table runs, their checks, and the report document."""

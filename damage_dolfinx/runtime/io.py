@@ -1,0 +1,250 @@
+"""Output of a run: XDMF time series, CSV history, JSON metadata, gathered final fields.
+
+Everything is written incrementally: the XDMF file is re-opened in append mode for each output
+time and the CSV row is flushed after each step, so an interrupted run keeps every finished step.
+Only rank 0 writes CSV/JSON/NPZ; XDMF is collective. JSON and NPZ files are written to a temporary
+file and renamed (atomic.py: a kill never leaves a truncated file); the history is appended row by
+row (a full disk can truncate at most its last row, which a restart drops). A write that fails on
+any rank raises OutputError on every rank (``atomic.collective``), so ranks never wait for each
+other. The run folder and its lock: runfolder.py.
+"""
+from __future__ import annotations
+
+import contextlib
+import csv
+import ctypes
+import errno
+import io as _io
+import os
+import platform
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from damage_dolfinx import compat
+from damage_dolfinx.runtime.atomic import (STUCK_SECONDS, OutputError, atomic_write_bytes, collective,  # noqa: F401
+                     describe, npz_writer, write_json)
+from damage_dolfinx.parameters import InputError
+
+
+def prepare_output_dir(path, comm=MPI.COMM_WORLD) -> Path:
+    """Create ``path`` and check it is writable, before any computation; raises InputError."""
+    path = Path(path)
+    error = None
+    if comm.rank == 0:
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+            probe = path / ".write_test"
+            probe.write_text("ok")
+            probe.unlink()
+        except OSError as exc:
+            error = f"output folder {str(path)!r} is not writable: {exc.strerror or exc}"
+    error = comm.bcast(error, root=0)
+    if error:
+        raise InputError(error)
+    return path
+
+
+def environment(comm=MPI.COMM_WORLD) -> dict:
+    """Versions and machine facts for the run metadata."""
+    import petsc4py
+    import ufl
+    from petsc4py import PETSc
+    from damage_dolfinx import __version__
+    return {"damage_dolfinx": __version__, "dolfinx": compat.DOLFINX_VERSION,
+            "ufl": ufl.__version__, "petsc": ".".join(map(str, PETSc.Sys.getVersion())),
+            "petsc4py": petsc4py.__version__, "python": platform.python_version(),
+            "mpi_size": comm.size, "host": platform.node(),
+            "command": " ".join(sys.argv), "date": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+
+
+class CSVHistory:
+    """One CSV row per time step, appended and flushed immediately (rank 0). A failed write is
+    kept in ``error`` (the runner checks it collectively at the end of the step) instead of
+    raising on rank 0 alone."""
+
+    def __init__(self, path, columns, comm=MPI.COMM_WORLD, keep_until_step=None):
+        """A new file, or with ``keep_until_step`` (restart) the existing complete rows of steps
+        up to that one followed by the new rows; the file is replaced atomically, then appended.
+        Raises OSError (rank 0)."""
+        self.columns, self.comm, self.path = list(columns), comm, Path(path)
+        self._file, self.error = None, None
+        if comm.rank == 0:
+            kept = self.read_rows(path, keep_until_step) if keep_until_step is not None else []
+
+            def write(f):
+                text = _io.TextIOWrapper(f, newline="", encoding="utf-8")
+                writer = csv.DictWriter(text, fieldnames=self.columns)
+                writer.writeheader()
+                for row in kept:
+                    writer.writerow({c: row.get(c, "") for c in self.columns})
+                text.flush()
+                text.detach()
+            atomic_write_bytes(path, write)
+            self._file = open(path, "a", newline="")
+            self._writer = csv.DictWriter(self._file, fieldnames=self.columns)
+
+    @staticmethod
+    def read_rows(path, until_step) -> list:
+        """Complete rows (all columns, ending in a newline) of steps <= until_step."""
+        if not Path(path).is_file():
+            return []
+        text = Path(path).read_text()
+        if text and not text.endswith("\n"):  # a row cut by a full disk
+            text = text[:text.rfind("\n") + 1]
+        rows = csv.DictReader(text.splitlines())
+        return [r for r in rows if None not in r.values() and None not in r
+                and r["step"].isdigit() and int(r["step"]) <= until_step]
+
+    def write(self, row: dict):
+        if self._file is not None and self.error is None:
+            try:
+                self._writer.writerow({c: row.get(c, "") for c in self.columns})
+                self._file.flush()
+            except OSError as exc:
+                self.error = exc
+
+    def close(self):
+        if self._file is not None:
+            try:
+                self._file.close()
+            except OSError:
+                pass  # a full disk: the rows that were flushed stay
+            self._file = None
+
+
+class XDMFSeries:
+    """XDMF/HDF5 time series of several fields on one mesh, for ParaView. A failed write (full
+    disk) raises RuntimeError with one line: HDF5's own error stack is held back (shown only if
+    the write succeeds anyway), and the file object whose close failed is never destroyed
+    (DOLFINx 0.5 crashes closing it a second time)."""
+
+    def __init__(self, path, msh):
+        self.path, self.comm = Path(path), msh.comm
+        f = compat.xdmf_file(self.comm, self.path, "w")
+        with _failed_files_kept(f), _stderr_held_back():
+            with f:
+                f.write_mesh(msh)
+
+    def write(self, functions, t: float):
+        """Append the fields at ``t``. DOLFINx rewrites the whole XML file in place, so a copy
+        of it (``.xdmf.bak``) exists while it does: a run killed then leaves a complete
+        previous XML, which ``repair_xdmf`` puts back."""
+        backup, error = self.path.with_name(self.path.name + ".bak"), None
+        need = 65536 + 2 * sum(fn.function_space.dofmap.index_map.size_global * 8 * (
+            fn.function_space.dofmap.index_map_bs) + 4096 for fn in functions)
+        if self.comm.rank == 0:
+            try:  # a write that fails half-way can leave ranks inside collective HDF5 calls
+                free = shutil.disk_usage(self.path.parent).free
+                need += 2 * self.path.stat().st_size
+                if free < need:
+                    raise OSError(errno.ENOSPC, f"No space left on device ({free // 1024} kB "
+                                                f"free, the output needs ~{need // 1024} kB)")
+                shutil.copyfile(self.path, backup)
+            except OSError as exc:
+                error = exc
+        error = self.comm.bcast(error, root=0)  # every rank stops before the collective open
+        if error:
+            raise error
+        f = compat.xdmf_file(self.comm, self.path, "a")
+        with _failed_files_kept(f), _stderr_held_back():
+            with f:
+                for fn in functions:
+                    f.write_function(fn, t)
+        if self.comm.rank == 0:
+            backup.unlink()
+
+
+def repair_xdmf(out) -> list:
+    """Put back the XML of every XDMF file in ``out`` whose write was killed (it does not
+    parse and its ``.bak`` does); returns the names repaired (rank 0)."""
+    repaired = []
+    for backup in sorted(Path(out).glob("*.xdmf.bak")):
+        path = backup.with_name(backup.name[:-4])
+        try:
+            if not _parses(path) and _parses(backup):
+                os.replace(backup, path)
+                repaired.append(path.name)
+            else:
+                backup.unlink()  # the write had finished (or the copy is no better)
+        except OSError:
+            pass  # left as it is: the restart itself does not need it
+    return repaired
+
+
+def _parses(path) -> bool:
+    import xml.etree.ElementTree as ET
+    try:
+        ET.parse(path)
+        return True
+    except (ET.ParseError, OSError):
+        return False
+
+
+#: XDMF files whose close failed: DOLFINx 0.5 / HDF5 crash (SIGSEGV) when such a file is
+#: destroyed or when HDF5 shuts down, so they are kept alive and the command line ends the
+#: process with os._exit (cli.py) when this list is not empty
+FAILED_HDF5_FILES = []
+
+
+@contextlib.contextmanager
+def _failed_files_kept(f):
+    try:
+        yield
+    except RuntimeError:
+        FAILED_HDF5_FILES.append(f)
+        ctypes.pythonapi.Py_IncRef(ctypes.py_object(f))  # never destroyed: no second close
+        raise
+
+
+@contextlib.contextmanager
+def _stderr_held_back():
+    """File descriptor 2 goes to a memory file; replayed unless an exception is raised."""
+    sys.stderr.flush()
+    saved, memory = os.dup(2), os.memfd_create("held-back-stderr")
+    os.dup2(memory, 2)
+    failed = True
+    try:
+        yield
+        failed = False
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        if not failed and os.lseek(memory, 0, os.SEEK_END):
+            os.lseek(memory, 0, os.SEEK_SET)
+            sys.stderr.write(os.read(memory, 1 << 20).decode(errors="replace"))
+        os.close(memory)
+
+
+def gather_dof_field(u):
+    """On rank 0: (coords (N,2), values (N, bs)) of all owned dofs of a P1 or DG0 Function, in a
+    rank-independent order (sorted by coordinates); None elsewhere."""
+    V = u.function_space
+    n_owned = V.dofmap.index_map.size_local
+    bs = V.dofmap.index_map_bs
+    coords = V.tabulate_dof_coordinates()[:n_owned, :V.mesh.topology.dim]  # (N,2), 3-D: (N,3)
+    values = u.x.array.reshape(-1, bs)[:n_owned]
+    all_coords = V.mesh.comm.gather(coords, root=0)
+    all_values = V.mesh.comm.gather(values, root=0)
+    if V.mesh.comm.rank != 0:
+        return None
+    coords = np.concatenate(all_coords)
+    values = np.concatenate(all_values)
+    key = np.round(coords, 10)
+    order = np.lexsort(key.T[::-1])  # by x, then y (then z)
+    return coords[order], values[order]
+
+
+def save_final_fields(path, functions: dict):
+    """Write the gathered final fields (name -> Function) to one NPZ (rank 0)."""
+    data = {}
+    for name, fn in functions.items():
+        gathered = gather_dof_field(fn)
+        if gathered is not None:
+            data[name + "_coords"], data[name] = gathered
+    if data:
+        atomic_write_bytes(path, npz_writer(data))

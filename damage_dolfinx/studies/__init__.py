@@ -1,0 +1,1 @@
+"""Studies built on runs: convergence against a fine reference."""

@@ -1,0 +1,386 @@
+"""Convergence study against a fine reference solution (thesis Tables 2.1, 2.4, ...).
+
+The reference run and all coarse runs advance in lockstep: whenever the reference reaches a
+coarse run's next time level, that run takes its step, is transferred exactly to the nested
+reference mesh (:func:`post.nested_transfer`, P1 or DG0) and its error is measured there,
+
+    e(n, k) = max over common time levels of the sum of the stepper's ``error_components``
+              (default ||u_ref - u_hk||_V + ||zeta_ref - zeta_hk||_Y; each problem sets the
+              norm its thesis table uses, e.g. ||sigma||_Q for 2.4, ||v||_H for 3.1),
+
+so no reference history is stored. Everything runs under MPI. By default (reference_ranks 1,
+issue 18) the reference runs serially on rank 0 and every cell serially on the other ranks,
+which send their cells' nodal values to rank 0 without waiting for it; with ``--reference-ranks
+all`` the reference and the cells n > SERIAL_CELL_MAX_N run on all ranks and the smaller cells
+serially, shared out among all ranks. The norm is one product with a Gram matrix.
+Outputs: ``errors.csv``, ``errors.md``, ``convergence.png`` (log-log error vs h + k with the
+fitted rate) and ``summary.json``.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from dolfinx import fem
+from mpi4py import MPI
+
+from damage_dolfinx.catalogue import examples
+from damage_dolfinx.runtime import io
+from damage_dolfinx.viz import post
+from damage_dolfinx.parameters import InputError, TimeGrid
+from damage_dolfinx.runtime.runner import Progress
+
+
+class _CoarseRun:
+    """One coarse (n, k) cell: its stepper (on the ranks that run it) and its error components
+    transferred to the reference mesh.
+
+    ``owner`` None: the cell runs on all ranks of the study (large cells). Otherwise it runs
+    serially on rank ``owner`` (``stepper`` is None on the other ranks), which sends the grid
+    values of its components to the ranks of the reference mesh at each measurement.
+    """
+
+    def __init__(self, n, k, ratio, owner, stepper):
+        self.n, self.k, self.ratio, self.owner, self.stepper = n, k, ratio, owner, stepper
+        self.err_parts, self.err, self.err_T, self.wall = {}, 0.0, 0.0, 0.0
+
+    @property
+    def mine(self) -> bool:
+        return self.stepper is not None
+
+    def connect(self, ref, grid, h, transfers, norms, comm, ref_rank=None, world=None,
+                outbox=None):
+        """Set up the measurement against ``ref`` (collective on ``comm``, the reference's).
+        ``ref_rank``: the reference runs on that rank of ``world`` alone (``ref`` is None on
+        the others, which only send their cells' values, without waiting: ``outbox`` holds
+        the sends in flight, shared by the cells of a rank)."""
+        self.h, self.comm, self.norms = h, comm, norms
+        self.ref_rank, self.world, self.outbox = ref_rank, world, outbox
+        self.components = []
+        if ref is None:  # a rank without the reference: the coarse halves of its own cells
+            self._send = [post.nested_transfer(f.function_space, None, grid)
+                          for _, f, _ in self.stepper.error_components] if self.mine else []
+            return
+        coarse = dict((name, f) for name, f, _ in self.stepper.error_components) \
+            if self.mine else {}
+        for name, f_ref, _ in ref.error_components:
+            fine_side = transfers(grid, f_ref.function_space)
+            f = coarse.get(name)
+            coarse_side = post.nested_transfer(f.function_space, None, grid) \
+                if f is not None else None
+            self.components.append((name, fine_side, coarse_side, f,
+                                    fem.Function(f_ref.function_space)))
+        self.err_parts = {name: 0.0 for name, *_ in self.components}
+
+    def advance(self, initial=False):
+        start = time.perf_counter()
+        self.stepper.initialize() if initial else self.stepper.advance()
+        self.wall += time.perf_counter() - start
+
+    def measure(self):
+        """Error at the current common time level; collective on the reference's ranks (with
+        a reference on rank 0 alone, the owner sends its grid values there, point to point)."""
+        if self.ref_rank is not None and self.world.rank != self.ref_rank:
+            if self.mine:  # send each component (the reference's order: same example)
+                for (_, f, _), coarse_side in zip(self.stepper.error_components, self._send):
+                    values = np.ascontiguousarray(coarse_side.grid_values(f))
+                    self.outbox.append((self.world.Isend(values, dest=self.ref_rank, tag=7),
+                                        values))
+                if len(self.outbox) > MAX_SENDS_IN_FLIGHT:  # bound the memory of a fast rank
+                    half = len(self.outbox) // 2
+                    MPI.Request.Waitall([req for req, _ in self.outbox[:half]])
+                    del self.outbox[:half]
+            return
+        total = 0.0
+        for name, fine_side, coarse_side, f, f_fine in self.components:
+            if self.owner is None or self.mine:
+                on_grid = coarse_side.grid_values(f)
+                if self.owner is not None and self.ref_rank is None and self.comm.size > 1:
+                    self.comm.Bcast(on_grid, root=self.owner)
+            else:
+                on_grid = np.empty(fine_side.grid_shape)
+                if self.ref_rank is None:
+                    self.comm.Bcast(on_grid, root=self.owner)
+                else:
+                    self.world.Recv(on_grid, source=self.owner, tag=7)
+            fine_side.to_fine(on_grid, f_fine)
+            e = self.norms[name](f_fine)
+            self.err_parts[name] = max(self.err_parts[name], e)
+            total += e
+        self.err = max(self.err, total)
+        self.err_T = total  # the last measurement is at t = T
+
+
+#: sends of cell values a rank may have in flight to the reference's rank (then it waits for
+#: the older half): the cells' ranks run ahead of the reference by up to this many messages
+MAX_SENDS_IN_FLIGHT = 400
+
+#: coarse cells with at most this many mesh cells per side run serially, shared out among
+#: the ranks (a 2-rank step of a small mesh is slower than a serial one); larger cells, like
+#: the reference, run on all ranks
+SERIAL_CELL_MAX_N = 64
+
+
+def _owners(ns, ks, T, size, serial_max_n=SERIAL_CELL_MAX_N, exclude=None) -> dict:
+    """(n, k) -> rank that runs the cell serially, or None (all ranks). The serial cells of each
+    k (they step at the same time levels) are shared out greedily by cost, steps x vertices,
+    to the rank with the least work in that k, then in total: the ranks wait for each other at
+    every reference step, so the balance must hold per time level, not only on the sum.
+    ``exclude``: a rank that gets no cell (the one running the reference alone)."""
+    owners, total = {}, np.zeros(size)
+    ranks = [r for r in range(size) if r != exclude] or list(range(size))
+    for k in ks:
+        in_k = np.zeros(size)
+        for n in sorted(ns, reverse=True):
+            if size == 1 or n > serial_max_n:
+                owners[(n, k)] = None
+                continue
+            rank = min(ranks, key=lambda r: (in_k[r], total[r]))
+            cost = (T / k) * (n + 1) ** 2
+            in_k[rank] += cost
+            total[rank] += cost
+            owners[(n, k)] = rank
+    return owners
+
+
+def _cell_geometry(runs, comm):
+    """{(n, k): (grid, h)} of every cell on every rank (each rank knows its own cells')."""
+    mine = {(r.n, r.k): (r.stepper.data.geometry.grid, r.stepper.data.geometry.h)
+            for r in runs if r.mine and (r.owner is None and comm.rank == 0 or r.owner is not None)}
+    out = {}
+    for part in comm.allgather(mine):
+        out.update(part)
+    return out
+
+
+def _component_norms(ref):
+    """{name: ComponentNorm} of the reference stepper's ``error_components``."""
+    return {name: post.ComponentNorm(f, norm) for name, f, norm in ref.error_components}
+
+
+def _error_definition(components) -> str:
+    label = {"V": "||{0} - {0}_hk||_V", "L2": "||{0} - {0}_hk||_L2"}
+    return "max_n (" + " + ".join(label[norm].format(name) for name, _, norm in components) + ")"
+
+
+def _check_nested(ref_n, ref_k, ns, ks):
+    for n in ns:
+        if ref_n % n:
+            raise InputError(f"coarse mesh n = {n} is not nested in the reference n = {ref_n}")
+        if n >= ref_n:
+            raise InputError(f"coarse mesh n = {n} must be coarser than the reference n = {ref_n}")
+    for k in ks:
+        ratio = k / ref_k
+        if abs(ratio - round(ratio)) > 1e-8 * ratio or round(ratio) < 1:
+            raise InputError(f"reference k = {ref_k} must divide every coarse k (k = {k})")
+
+
+def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, overrides=None,
+          progress=True, comm=MPI.COMM_WORLD, serial_max_n=SERIAL_CELL_MAX_N,
+          reference_ranks=None) -> dict:
+    """Run the study; returns the summary (errors per (n, k), fitted rates, wall times).
+
+    ``reference_ranks`` (default: the catalogue's ``convergence["reference_ranks"]``, else 1):
+    1 runs the reference serially on rank 0 and every coarse cell serially on the other ranks
+    (the measurements on rank 0); "all" runs the reference and the cells n > SERIAL_CELL_MAX_N
+    on all ranks, the smaller cells serially shared out among all ranks. On 2 cores the first
+    is faster for every thesis study (issue 18, benchmarks/README.md): a serial step uses
+    PETSc's Cholesky and the serial-only zeta-linear matrices of 3.3, MUMPS on 2 ranks is no
+    faster than that, and the second rank is free for the cells. A finer reference on many
+    ranks wants "all"."""
+    wall_start = time.perf_counter()
+    from damage_dolfinx.runtime.runner import resolve
+    ex = resolve(example_id, overrides)
+    example_id = ex.id
+    overrides = dict(overrides or {})
+    if not ex.own:  # the thesis's own time steps run as the thesis ran them (warn above k_max)
+        overrides.setdefault("stability_check", ex.params.extra.get("stability_check", "warn"))
+    defaults = ex.convergence or {}
+    if ex.n is None:
+        raise InputError(f"example {example_id} has no nested structured meshes; "
+                         "convergence studies need one (e.g. 2.1-ex1)")
+    ref_n = ref_n or defaults["ref_n"]
+    ref_k = ref_k or defaults["ref_k"]
+    ns, ks = list(ns or defaults["n"]), list(ks or defaults["k"])
+    T = T or ex.T
+    _check_nested(ref_n, ref_k, ns, ks)
+    for n in ns + [ref_n]:
+        ex.configure(n=n, k=ref_k, T=T, overrides=overrides)
+    for k in ks:
+        TimeGrid(k, T)
+    out = io.prepare_output_dir(out, comm)
+
+    ref_serial = comm.size > 1 and (reference_ranks or defaults.get("reference_ranks", 1)) == 1
+    ref_rank, ref_comm = (0, MPI.COMM_SELF) if ref_serial else (None, comm)
+    ref = ex.build(ref_comm, n=ref_n, k=ref_k, T=T, overrides=overrides) \
+        if not ref_serial or comm.rank == ref_rank else None
+    norms = _component_norms(ref) if ref is not None else {}
+    owners = _owners(ns, ks, T, comm.size, max(ns) if ref_serial else serial_max_n,
+                     exclude=ref_rank)
+    runs = []
+    for n in ns:
+        for k in ks:
+            owner = owners[(n, k)]
+            stepper = None
+            if owner is None:
+                stepper = ex.build(comm, n=n, k=k, T=T, overrides=overrides)
+            elif owner == comm.rank:
+                stepper = ex.build(MPI.COMM_SELF, n=n, k=k, T=T, overrides=overrides)
+            runs.append(_CoarseRun(n, k, int(round(k / ref_k)), owner, stepper))
+    geometry = _cell_geometry(runs, comm)
+    fine_sides = {}
+
+    def transfers(grid, V_fine):  # the fine half of a transfer, shared by the cells of one n
+        key = (grid.nx, grid.ny, id(V_fine))
+        if key not in fine_sides:
+            fine_sides[key] = post.nested_transfer(None, V_fine, grid)
+        return fine_sides[key]
+
+    outbox = []
+    for run in runs:
+        run.connect(ref, *geometry[(run.n, run.k)], transfers, norms, ref_comm, ref_rank, comm,
+                    outbox)
+    num_steps = comm.bcast(ref.num_steps if comm.rank == 0 else None, root=0)
+    report = Progress(f"{ex.id} converge", num_steps, comm, enabled=progress, interval=10.0)
+
+    ref_wall = time.perf_counter()
+    stats = ref.initialize() if ref is not None else {}
+    ref_wall = time.perf_counter() - ref_wall
+    for run in runs:
+        if run.mine:
+            run.advance(initial=True)
+    for run in runs:
+        run.measure()
+    step, measure_wall = 0, 0.0
+    while step < num_steps:
+        start = time.perf_counter()
+        if ref is not None:
+            stats = ref.advance()
+        ref_wall += time.perf_counter() - start
+        step += 1
+        due = [run for run in runs if step % run.ratio == 0]
+        for run in due:  # serial cells first: no rank waits for the other inside a parallel one
+            if run.mine and run.owner is not None:
+                run.advance()
+        for run in due:
+            if run.owner is None:
+                run.advance()
+        start = time.perf_counter()
+        for run in due:
+            run.measure()
+        measure_wall += time.perf_counter() - start
+        if ref is not None:
+            report(step, ref.t, stats, ref.scalars)
+    MPI.Request.Waitall([req for req, _ in outbox])
+    cell_wall = comm.allreduce(np.array([r.wall if r.mine and (r.owner is not None or
+                                                               comm.rank == 0) else 0.0
+                                         for r in runs]), op=MPI.SUM)
+    for run, wall in zip(runs, cell_wall):
+        run.wall = float(wall)
+
+    components = comm.bcast([(name, None, norm) for name, _, norm in ref.error_components]
+                            if comm.rank == 0 else None, root=0)
+    if ref_serial:  # the errors were measured on rank 0
+        errors = comm.bcast([(r.err, r.err_T, r.err_parts) for r in runs]
+                            if comm.rank == 0 else None, root=0)
+        for r, (err, err_T, parts) in zip(runs, errors):
+            r.err, r.err_T, r.err_parts = err, err_T, parts
+    definition = _error_definition(components)
+    rows = [{"n": r.n, "h": r.h, "k": r.k, "h_plus_k": r.h + r.k, "error": r.err,
+             **{f"error_{name}_{norm}": r.err_parts[name] for name, _, norm in components},
+             "error_at_T": r.err_T, "wall_time_s": r.wall} for r in runs]
+    rates = fitted_rates(rows, ns, ks)
+    rates_T = fitted_rates(rows, ns, ks, key="error_at_T")
+    summary = {"schema": "damage-dolfinx/convergence/v1", "example": ex.id, "title": ex.title,
+               "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
+               "error_definition": definition,
+               "errors": rows, "rates": rates, "rates_at_T": rates_T, "mpi_size": comm.size,
+               "serial_cells": {"max_n": (max(ns) if ref_serial else serial_max_n)
+                                if comm.size > 1 else None,
+                                "rank_of_cell": [[r.n, r.k, r.owner] for r in runs]},
+               "reference": {"wall_time_s": ref_wall, "ranks": 1 if ref_serial else comm.size,
+                             "measurements_wall_time_s": measure_wall,
+                             **({"mesh": ref.mesh_info(), "final": ref.scalars(),
+                                 "iterations": ref.iteration_totals()} if ref is not None else {})},
+               "parameters": ref.params.as_dict() if ref is not None else None,
+               "assumptions": ex.assumptions,
+               "wall_time_s": time.perf_counter() - wall_start,
+               "environment": io.environment(comm)}
+    if comm.rank == 0:
+        write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
+        label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
+        plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k, definition)
+        print((out / "errors.md").read_text(), flush=True)
+    io.write_json(out / "summary.json", summary, comm)
+    return summary
+
+
+def fitted_rates(rows, ns, ks, key="error") -> dict:
+    """Observed orders of ``key``: in h + k over all cells and over the diagonal (n, k) pairs,
+    in h at the smallest k, in k at the finest n."""
+    rows = [dict(r, error=r[key]) for r in rows]
+    hk = [r["h_plus_k"] for r in rows]
+    err = [r["error"] for r in rows]
+    k_min, n_max = min(ks), max(ns)
+    col = [r for r in rows if r["k"] == k_min]
+    row = [r for r in rows if r["n"] == n_max]
+    m = min(len(ns), len(ks))
+    diag = [r for r in rows if (r["n"], r["k"]) in
+            zip(sorted(ns)[-m:], sorted(ks, reverse=True)[-m:])]
+    return {"h_plus_k_all": post.loglog_rate(hk, err),
+            "h_plus_k_diagonal": post.loglog_rate([r["h_plus_k"] for r in diag],
+                                                  [r["error"] for r in diag]),
+            "diagonal_pairs": [[r["n"], r["k"]] for r in diag],
+            "h_at_smallest_k": post.loglog_rate([r["h"] for r in col], [r["error"] for r in col]),
+            "k_at_finest_n": post.loglog_rate([r["k"] for r in row], [r["error"] for r in row])}
+
+
+def _markdown_table(title, values, ns, ks, rates):
+    lines = [title, "", "| n \\ k | " + " | ".join(f"{k:g}" for k in ks) + " |",
+             "|---|" + "---|" * len(ks)]
+    for n in ns:
+        lines.append(f"| {n} | " + " | ".join(f"{values[(n, k)]:.4e}" for k in ks) + " |")
+    return lines + ["", f"Observed rate in h + k (all cells): {rates['h_plus_k_all']:.3f}; "
+                    f"diagonal pairs {rates['diagonal_pairs']}: {rates['h_plus_k_diagonal']:.3f}; "
+                    f"in h at k = {min(ks):g}: {rates['h_at_smallest_k']:.3f}; "
+                    f"in k at n = {max(ns)}: {rates['k_at_finest_n']:.3f}", ""]
+
+
+def write_tables(out, rows, ns, ks, rates, rates_T, example_id, ref_n, ref_k, definition):
+    import csv
+    with open(out / "errors.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    lines = _markdown_table(
+        f"# {example_id}: error {definition}, "
+        f"reference n = {ref_n}, k = {ref_k}", {(r["n"], r["k"]): r["error"] for r in rows},
+        ns, ks, rates)
+    lines += _markdown_table(
+        "## Error at the final time T only (shows the time-discretisation error where the "
+        "maximum over time is attained at t = 0)",
+        {(r["n"], r["k"]): r["error_at_T"] for r in rows}, ns, ks, rates_T)
+    (out / "errors.md").write_text("\n".join(lines))
+
+
+def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="error"):
+    from damage_dolfinx.viz import figstyle
+    fig, ax = figstyle.plt().subplots(figsize=(6.4, 4.6))
+    ks = sorted({r["k"] for r in rows}, reverse=True)
+    for k in ks:
+        sel = sorted((r for r in rows if r["k"] == k), key=lambda r: r["h_plus_k"])
+        ax.loglog([r["h_plus_k"] for r in sel], [r["error"] for r in sel], "o-", ms=4,
+                  label=f"$k$ = {k:g}")
+    hk = np.array([r["h_plus_k"] for r in rows])
+    err = np.array([r["error"] for r in rows])
+    p = rates["h_plus_k_all"]
+    c = np.exp(np.mean(np.log(err) - p * np.log(hk)))
+    xs = np.array([hk.min(), hk.max()])
+    ax.loglog(xs, c * xs**p, "k--", label=f"fit: rate {p:.2f}")
+    ax.set_xlabel("$h + k$")
+    ax.set_ylabel(figstyle.error_mathtext(definition))
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    figstyle.log_tick_labels(ax)
+    figstyle.save(fig, path, title=f"{example_id}: convergence (reference $n$ = {ref_n}, "
+                  f"$k$ = {ref_k:g})")

@@ -1,0 +1,48 @@
+"""Running problems: :func:`run` one problem into a run folder, :func:`converge` a problem
+against a fine reference, :func:`gather` a field onto rank 0 (any number of ranks)."""
+from __future__ import annotations
+
+from mpi4py import MPI
+
+
+def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
+        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
+    """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
+    ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
+    ``out/summary.json``).
+
+    The folder receives what the command line writes for a catalogue example: ``summary.json``
+    (status, parameters, final scalars, timings, environment), ``fields.xdmf`` (u, zeta, von
+    Mises ... over time, for ParaView), ``history.csv`` (scalars per step), ``fields_final.npz``,
+    the figures, and checkpoints. ``restart=True`` continues from the folder's checkpoint (a
+    larger ``T`` continues a completed run); a folder that already holds a run is refused
+    unless ``restart`` or ``overwrite``. SIGTERM/SIGINT stop the run at the end of a step with a
+    checkpoint. Under ``mpirun`` every rank calls it; only rank 0 prints. ``n``, ``k``, ``T``
+    override the problem's own. Bad input raises :class:`~damage_dolfinx.InputError` before any
+    work; a solver that fails raises ConvergenceError after marking the summary "failed".
+    """
+    from damage_dolfinx.runtime.runner import run as _run
+    return _run(problem, out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                checkpoint_every=checkpoint_every, progress=progress, figures=figures,
+                comm=comm)
+
+
+def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
+             comm=MPI.COMM_WORLD) -> dict:
+    """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
+    run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
+    and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
+    mesh`` of nested structured meshes (:func:`damage_dolfinx.geometries.rectangle.rectangle`):
+    coarse solutions are transferred to the reference mesh exactly. Every n must divide
+    ``ref_n`` and every k must be a multiple of ``ref_k``."""
+    from damage_dolfinx.studies.convergence import study
+    return study(problem, out, ref_n=ref_n, ref_k=ref_k, ns=list(n), ks=list(k), T=T,
+                 progress=progress, comm=comm)
+
+
+def gather(function):
+    """``(coords, values)`` of a P1 or DG0 ``dolfinx.fem.Function`` on rank 0, all ranks'
+    owned dofs in a rank-independent order (sorted by coordinates), so that a serial run and a
+    parallel one compare entry by entry; ``None`` on the other ranks (collective)."""
+    from damage_dolfinx.runtime.io import gather_dof_field
+    return gather_dof_field(function)
