@@ -14,7 +14,7 @@ import shutil
 import subprocess
 import tempfile
 
-from damage_dolfinx.report import build
+from damage_dolfinx.report import build as report
 
 p = argparse.ArgumentParser()
 p.add_argument("--results", default="results")
