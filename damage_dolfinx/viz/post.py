@@ -300,7 +300,9 @@ def _strongest_load(expr, constants, t_const, times, points):
              for t in times]
     if not peaks or max(peaks) == 0.0:
         return None, None
-    t = float(times[len(peaks) - 1 - int(np.argmax(peaks[::-1]))])  # the last time of the peak
+    # the first time of the peak: a periodic load is drawn in its first half period (the
+    # compression of 3.1-ex2 pushes toward the obstacle at t = 0.25, pulls at t = 0.75)
+    t = float(times[int(np.argmax(np.asarray(peaks) >= max(peaks) * (1 - 1e-9)))])
     return ("constant" if max(peaks) - min(peaks) <= 1e-12 * max(peaks) else t), values(t, points)
 
 
