@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from damage_dolfinx.report import build, reproduce
+from damage_dolfinx.report import build as report, reproduce
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -101,7 +101,7 @@ def test_resumed_reproduction_keeps_completed_runs(tmp_path):
 def test_markdown_norm_at_line_start_is_text_not_a_table():
     """benchmarks/readings.md wraps lines that begin with a norm ('||eps(u)||_L2 = ...'): a
     pipe table needs its delimiter row, as in GitHub Markdown."""
-    from damage_dolfinx.report import doc
+    from damage_dolfinx.report import doc as report_doc
     html = report_doc._markdown_to_html("a reading,\n||eps(u)||_L2 = 1e-3, so\n\n| n | k |\n"
                                         "|---|--:|\n| 4 | 0.1 |\n")
     assert html.count("<table>") == 1 and "<p>a reading, ||eps(u)||_L2 = 1e-3, so</p>" in html
