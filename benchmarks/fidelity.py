@@ -3,7 +3,7 @@
     python benchmarks/fidelity.py [--results results] [--out results/fidelity]
 
 For every table of the thesis's ``tables.json`` (Tables 2.4-2.7, 3.1, 3.2; Tables 2.1 and 3.3
-are withheld on purpose and never inferred) it finds our study of the same example and writes,
+are not set beside ours and never inferred) it finds our study of the same example and writes,
 per cell (n, k) present in both, the ratio ours / thesis, their median (and min / max), the rate
 fitted to each table the same way (least-squares slope of log error against log (h + k) over
 all cells, h = diameter / n as in our studies) and a verdict. Nothing is copied by hand: every

@@ -241,7 +241,7 @@ nav.toc li {{ break-inside: avoid; }}
 td.ratio small {{ color: #555; display: block; font-size: 80%; }}
 td.good {{ background: #e6f4ea; }} td.bad {{ background: #fce8e6; }}
 p.note {{ font-size: 85%; color: #444; margin-top: -0.3em; }}
-nav.toc ol {{ columns: 2; font-size: 92%; }}
+nav.toc ol {{ columns: 2; column-gap: 3.5em; font-size: 92%; }}
 pre {{ background: #f4f4f4; padding: 0.5em; overflow-x: auto; white-space: pre-wrap; }}
 ul.assumptions {{ font-size: 82%; color: #333; }}
 h2 {{ border-bottom: 1px solid #999; break-after: avoid; }} h3, h4 {{ break-after: avoid; }}

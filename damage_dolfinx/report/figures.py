@@ -50,7 +50,7 @@ def _f(number, example, shows, files, checks=(), kind="field", quote="", related
 THESIS_FIGURES = [
     _f("2.1", "2.1-ex1", "square (0,5)^2 with a clamped hole, mesh for n = 10",
        ["figure_2_1.png"], kind="setting"),
-    _f("2.2", "2.1-ex1", "error against h + k: linear convergence (Table 2.1, withheld)",
+    _f("2.2", "2.1-ex1", "error against h + k: linear convergence (Table 2.1, not set beside ours)",
        ["figure_2_2.png"], kind="convergence"),
     _f("2.3", "2.1-ex2a", "disc |x| < 4 minus a diamond, mesh",
        ["figure_2_3.png"], kind="setting"),
@@ -190,7 +190,7 @@ THESIS_FIGURES = [
        " the most damaged ones."),
     _f("3.15", "3.3-ex1", "square (0,6)^2 setting", ["figure_3_15.png"],
        kind="setting"),
-    _f("3.16", "3.3-ex1", "error against k + h (Table 3.3, withheld)",
+    _f("3.16", "3.3-ex1", "error against k + h (Table 3.3, not set beside ours)",
        ["figure_3_16.png"], kind="convergence"),
     _f("3.17", "3.3-ex2", "damage on x2 = 3 at several times (self-mending in the "
        "centre, minima at the edges) and zeta(0, 6) reaching ζ* in finite time",

@@ -131,3 +131,20 @@ FORBIDDEN = [re.compile(p, re.I) for p in (
 def forbidden(text: str) -> list:
     """The forbidden words and paths found in ``text`` (empty: the text stands alone)."""
     return [m.group(0) for p in FORBIDDEN for m in p.finditer(text)]
+
+
+def self_contained_problems(folder) -> list:
+    """What keeps a report folder from standing alone: forbidden words and paths in its
+    documents, and links to images that are absolute, leave the folder or are missing."""
+    folder = Path(folder)
+    problems = []
+    for doc in sorted(folder.glob("*.html")) + sorted(folder.glob("*.md")):
+        text = doc.read_text()
+        problems += [f"{doc.name}: {w!r}" for w in forbidden(text)]
+        links = re.findall(r'<img[^>]* src="([^"]+)"', text) + re.findall(r"!\[[^]]*\]\(([^)]+)\)", text)
+        for link in links:
+            target = (folder / link).resolve()
+            if link.startswith("/") or "://" in link or folder.resolve() not in target.parents \
+                    or not target.is_file():
+                problems.append(f"{doc.name}: image {link!r} not inside the folder")
+    return problems
