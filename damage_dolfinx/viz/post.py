@@ -300,9 +300,14 @@ def _strongest_load(expr, constants, t_const, times, points):
              for t in times]
     if not peaks or max(peaks) == 0.0:
         return None, None
-    # the first time of the peak: a periodic load is drawn in its first half period (the
-    # compression of 3.1-ex2 pushes toward the obstacle at t = 0.25, pulls at t = 0.75)
-    t = float(times[int(np.argmax(np.asarray(peaks) >= max(peaks) * (1 - 1e-9)))])
+    # the end of the first stretch at the peak: a periodic load is drawn in its first half
+    # period (3.1-ex2 pushes toward the obstacle at t = 0.25 and pulls at t = 0.75), a load held
+    # on a plateau at the plateau's end (2.3-ex3: t = 0.5)
+    at_peak = np.asarray(peaks) >= max(peaks) * (1 - 1e-9)
+    i = int(np.argmax(at_peak))
+    while i + 1 < len(at_peak) and at_peak[i + 1]:
+        i += 1
+    t = float(times[i])
     return ("constant" if max(peaks) - min(peaks) <= 1e-12 * max(peaks) else t), values(t, points)
 
 
