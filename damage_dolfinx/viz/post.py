@@ -338,7 +338,9 @@ def plot_history(csv_path, columns, path, title=""):
                                 sharex=True, squeeze=False)
     for ax, (column, label) in zip(axes[:, 0], columns):
         ax.plot(t, [float(r[column]) if r[column] else np.nan for r in rows], lw=1.2)
+        label, scale = figstyle.si_unit(label, np.nanmax(np.abs(ax.get_ylim())))
         ax.set_ylabel(figstyle.mathtext(label))
+        figstyle.plain_ticks(ax.yaxis, scale)  # every tick written out: no '1e-11' multiplier
         ax.grid(True, alpha=0.3)
         if "zeta" in column:
             ax.set_ylim(0, 1.05)
