@@ -57,7 +57,7 @@ def test_quick_figures_and_report(tmp_path):
 def _self_contained(folder, tmp_path):
     """The report folder stands alone: no machine path, tracker history or internal code, every
     image inside it; it still displays after a move. The check fails on a planted path."""
-    from damage_dolfinx.report_text import self_contained_problems
+    from damage_dolfinx.report.text import self_contained_problems
     assert self_contained_problems(folder) == []
     moved = tmp_path / "elsewhere" / "copy"
     shutil.copytree(folder, moved)
@@ -137,9 +137,9 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
     fitted reading 'reproduced under a reading' with the departure named."""
     import numpy as np
     from damage_dolfinx import figstyle
-    from damage_dolfinx.report_checks import departure, judge
-    from damage_dolfinx.report_figures import ThesisFigure
-    from damage_dolfinx.report_verdicts import CLASSES, category
+    from damage_dolfinx.report.checks import departure, judge
+    from damage_dolfinx.report.figures import ThesisFigure
+    from damage_dolfinx.report.verdicts import CLASSES, category
     xs = np.linspace(0.0, 1.0, 9)
     cells = np.array([[(xs[i], xs[j]), (xs[i + 1], xs[j]), (xs[i + 1], xs[j + 1])]
                       for i in range(8) for j in range(8)])
@@ -173,7 +173,7 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
 def test_reader_text_and_units():
     """Thesis line numbers become sections and pages, codes their meaning; stresses in MPa."""
     from damage_dolfinx import figstyle
-    from damage_dolfinx.report_text import assumption, forbidden, reader_text
+    from damage_dolfinx.report.text import assumption, forbidden, reader_text
     assert reader_text("(thesis line 3973)") == "(thesis §3.2.3, p. 176)"
     assert assumption("G6: kappa = 1e-2 (missing in the thesis)") == \
         "assumed: kappa = 1e-2 (missing in the thesis)"
