@@ -75,9 +75,10 @@ figures: setup
 figures-quick: setup
 	$(PY) benchmarks/figures.py --quick --np $(NP) --out $(OUT)/figures-quick $(if $(RESUME),--resume)
 
-# results/REPORT.md and results/REPORT.html from the figures, tables and benchmark outputs.
+# $(OUT)/report/: REPORT.html with its images, REPORT.md and REPORT.pdf (headless Chromium), one
+# folder that still works when moved or zipped.
 report: setup
-	$(PY) benchmarks/report.py --results $(OUT)
+	$(PY) benchmarks/report.py --results $(OUT) --pdf
 
 # Platforms (root, debootstrap; roots cached in /var/cache/damage-dolfinx/roots, rebuilt when
 # missing): the README's two commands in a bare Debian 12 minbase root (AS_USER=1: as a non-root

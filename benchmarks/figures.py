@@ -11,6 +11,7 @@ Thesis pairs drawn by different runs or at different times (2.4/2.5, 2.17, 2.20,
 3.8) are then re-rendered from their saved panel data on one stress scale (figstyle.render_pair).
 """
 import argparse
+import sys
 from pathlib import Path
 
 from damage_dolfinx.viz import figstyle
@@ -60,3 +61,5 @@ print(f"{len(index['figures'])} figures from {len(index['runs'])} runs in "
       f"{index['wall_time_this_invocation_s']} s (runs: {index['wall_time_s']} s in two lanes) "
       f"({mode} mode, {a.np} ranks) -> {out}; failed runs: {[r['example'] for r in failed] or 'none'}; "
       f"pairs on shared scales: {len(shared)}")
+if failed:  # `make figures` fails when a run fails (the index and the report still say which)
+    sys.exit(1)

@@ -8,7 +8,7 @@
 reference_output/convergence (default reading) and reference_output/convergence-literal (the
 literal reading, where the default differs), as in the table of issue 16.
 
-TABLE is a key of ../shared/thesis/tables.json (2.4, 2.5, 2.6, 2.7, 3.1, 3.2); each FOLDER holds
+TABLE is a key of benchmarks/thesis_tables.json (2.4, 2.5, 2.6, 2.7, 3.1, 3.2); each FOLDER holds
 a study's errors.csv (damage-dolfinx converge). Prints, per folder, a markdown block: the cells
 in common, min / median / max of the ratio, the fitted rates in h + k of the thesis and of ours
 over the same cells (least squares in log-log, h + k of our errors.csv), and the ratio table.
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-TABLES = Path(__file__).resolve().parents[2] / "shared" / "thesis" / "tables.json"
+TABLES = Path(__file__).resolve().parent / "thesis_tables.json"
 
 
 def compare(table: dict, folder: Path, column: str = "error", exclude=()) -> dict:

@@ -1,12 +1,14 @@
-"""Build results/REPORT.md and results/REPORT.html from what `make figures` and
-`make convergence` wrote (and the committed benchmark outputs): title block with the verdict
-counts, table of contents, summary (one row per thesis table and figure, with its verdict and a
-link), known differences, the thesis's tables beside ours (benchmarks/fidelity.py, also written
-to RESULTS/fidelity/), every figure with a caption of what the thesis shows.
+"""Build the report folder RESULTS/report/ (REPORT.html with its images, REPORT.md) from what
+`make figures` and `make convergence` wrote (and the committed benchmark outputs): title block
+with the count of each verdict class, contents, summary (one row per thesis table and figure,
+with its graded verdict and a link), known differences, the thesis's tables beside ours
+(benchmarks/fidelity.py, also written to RESULTS/fidelity/), every figure with the thesis
+sentence it is checked against.
 
     python benchmarks/report.py [--results results] [--pdf]
 
-``--pdf`` also prints RESULTS/REPORT.pdf with headless Chromium (--print-to-pdf).
+``--pdf`` also prints RESULTS/report/REPORT.pdf with headless Chromium (--print-to-pdf). The
+folder is self-contained: move or zip it as a whole.
 """
 import argparse
 import re
@@ -21,9 +23,9 @@ p.add_argument("--results", default="results")
 p.add_argument("--pdf", action="store_true", help="also print REPORT.pdf with headless Chromium")
 a = p.parse_args()
 page = report.build(a.results)
-counts = re.search(r"\d+ reproduced, \d+ differ, \d+ not comparable", page.read_text())
-print(f"report: {page} and {page.with_suffix('.md')}"
-      + (f" ({counts.group(0)})" if counts else ""))
+counts = re.search(r"\*\*(\d+ reproduced, .*?)\*\*", page.with_suffix(".md").read_text())
+print(f"report: {page.parent}/ (REPORT.html, REPORT.md, images/)"
+      + (f": {counts.group(1)}" if counts else ""))
 chromium = shutil.which("chromium") or shutil.which("chromium-browser")
 if a.pdf and chromium:
     with tempfile.TemporaryDirectory() as profile:

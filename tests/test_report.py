@@ -28,9 +28,11 @@ def test_quick_figures_and_report(tmp_path):
     files = {f["file"] for f in index["figures"]}
     assert {"figure_2_14.png", "2.3-ex1_fields_final.png"} <= files
     page = report.build(tmp_path)
-    md = (tmp_path / "REPORT.md").read_text()
+    folder = tmp_path / "report"
+    assert page == folder / "REPORT.html"
+    md = (folder / "REPORT.md").read_text()
     assert "damage-dolfinx run 2.3-ex1" in md          # traceable to its command
-    assert "G11" in md and "Observed rate" in md        # assumptions and a convergence table
+    assert "assumed: " in md and "Observed rate" in md  # assumptions and a convergence table
     text = page.read_text()
     assert 'id="contents"' in text and 'id="summary"' in text   # TOC and summary table
     summary = text[text.index('<table class="summary">'):]
@@ -40,18 +42,40 @@ def test_quick_figures_and_report(tmp_path):
     assert len(links) >= 50 and set(links) <= anchors           # every row links to its anchor
     toc = re.findall(r'href="#([\w.-]+)"', text[:text.index('id="summary"')])
     assert toc and set(toc) <= anchors
-    assert re.search(r"\d+ reproduced, \d+ differ, \d+ not comparable", text)
-    assert 'id="fig-2-14"' in text and "thesis lines" in text   # the produced figure, captioned
+    counts = re.search(r"\*\*(\d+) reproduced, (\d+) reproduced under a reading, (\d+) setting "
+                       r"assumed, (\d+) not visible in this figure, (\d+) differs, (\d+) not "
+                       r"comparable\*\* \(of (\d+)\)", md)
+    assert counts and sum(map(int, counts.groups()[:6])) == int(counts.group(7))
+    assert 'id="fig-2-14"' in text and "§2.3.3, p. 106" in text   # the figure, where in the thesis
     for anchor in ("performance", "step-floor", "scaling-3d"):  # the benchmark records
         assert f'id="{anchor}"' in text and f'href="#{anchor}"' in text
     assert "step over SpMV" in md and "dofs u" in md     # floor profile and 3-D scaling tables
     _damage_bars_fixed_and_factors_round(tmp_path / "figures", index)
+    _self_contained(folder, tmp_path)
+
+
+def _self_contained(folder, tmp_path):
+    """The report folder stands alone: no machine path, tracker history or internal code, every
+    image inside it; it still displays after a move. The check fails on a planted path."""
+    from damage_dolfinx.report.text import self_contained_problems
+    assert self_contained_problems(folder) == []
+    moved = tmp_path / "elsewhere" / "copy"
+    shutil.copytree(folder, moved)
+    shutil.rmtree(folder)                      # nothing outside the copy is left to link to
+    assert self_contained_problems(moved) == []
+    planted = moved / "REPORT.html"
+    clean = planted.read_text()
+    planted.write_text(clean.replace("<body>", "<body><p>see /work/main/results/x.png</p>", 1))
+    assert any("/work/" in p for p in self_contained_problems(moved))
+    planted.write_text(clean.replace("<body>", '<body><img src="../figures/figure_2_14.png">', 1))
+    assert any("not inside the folder" in p for p in self_contained_problems(moved))
+    planted.write_text(clean)
     if CHROMIUM is None:
         pytest.skip("chromium not installed (make setup installs it)")
-    loaded, total = _images_in_chromium(page)
+    loaded, total = _images_in_chromium(planted)
     assert total >= 3 and loaded == total
-    broken = tmp_path / "broken.html"  # the check can fail: a missing image is reported
-    broken.write_text(page.read_text().replace("<body>", '<body><img src="missing.png">', 1))
+    broken = moved / "broken.html"  # the check can fail: a missing image is reported
+    broken.write_text(clean.replace("<body>", '<body><img src="missing.png">', 1))
     loaded, total = _images_in_chromium(broken)
     assert loaded == total - 1
 
@@ -105,3 +129,55 @@ def test_markdown_norm_at_line_start_is_text_not_a_table():
     html = report_doc._markdown_to_html("a reading,\n||eps(u)||_L2 = 1e-3, so\n\n| n | k |\n"
                                         "|---|--:|\n| 4 | 0.1 |\n")
     assert html.count("<table>") == 1 and "<p>a reading, ||eps(u)||_L2 = 1e-3, so</p>" in html
+
+
+def test_verdict_classes_on_synthetic_figures(tmp_path):
+    """A damage field that is one colour on the fixed scale is 'not visible in this figure'
+    (and the figure gets a panel on the field's range); a failed check 'differs'; a run under a
+    fitted reading 'reproduced under a reading' with the departure named."""
+    import numpy as np
+    from damage_dolfinx import figstyle
+    from damage_dolfinx.report.checks import departure, judge
+    from damage_dolfinx.report.figures import ThesisFigure
+    from damage_dolfinx.report.verdicts import CLASSES, category
+    xs = np.linspace(0.0, 1.0, 9)
+    cells = np.array([[(xs[i], xs[j]), (xs[i + 1], xs[j]), (xs[i + 1], xs[j + 1])]
+                      for i in range(8) for j in range(8)])
+    stress = 1e6 * (2 - cells[..., 1].mean(1))              # highest at the bottom (DG0)
+
+    def npz(zeta, name):
+        panels = [dict(xy=cells, values=stress, name="von_mises", label="von Mises stress [Pa]"),
+                  dict(xy=cells, values=zeta, name="zeta", label="damage zeta")]
+        figstyle.save_panels(tmp_path / f"{name}.png", panels, title="t", amplification=1.0,
+                             zeta_star=0.01, ref_xy=cells)
+        figstyle.render_saved(tmp_path / f"{name}{figstyle.PANEL_SUFFIX}", tmp_path / f"{name}.png")
+        return tmp_path / f"{name}{figstyle.PANEL_SUFFIX}"
+
+    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"))
+    faint = npz(0.95 + 0.04 * cells[..., 1], "faint")       # most damaged at the bottom, narrow
+    verdict, got, _ = judge(fig, [faint])
+    assert category(verdict) == "not visible in this figure" and "rank together" in verdict
+    strong = npz(0.2 + 0.8 * cells[..., 1], "strong")
+    assert judge(fig, [strong])[0] == "reproduced"
+    wrong = npz(1.0 - 0.8 * cells[..., 1], "wrong")           # most damaged at the top
+    assert judge(fig, [wrong])[0].startswith("differs: does not hold: stress and damage")
+    fitted = "R1 (evidence reading; FITTED value): kappa = 0.003 instead of kappa = 1 (line 3973). x"
+    verdict = judge(fig, [strong], context={"departures": [fitted]})[0]
+    assert verdict == "reproduced under a reading: kappa = 0.003 instead of kappa = 1 (fitted)"
+    assert category(verdict) in CLASSES
+    assert departure(fitted) == "kappa = 0.003 instead of kappa = 1 (fitted)"
+    none = npz(np.full(cells.shape[:2], 0.99995), "none")      # no damage: nothing to locate
+    assert judge(fig, [none])[0].startswith("not visible in this figure: no damage")
+
+
+def test_reader_text_and_units():
+    """Thesis line numbers become sections and pages, codes their meaning; stresses in MPa."""
+    from damage_dolfinx import figstyle
+    from damage_dolfinx.report.text import assumption, forbidden, reader_text
+    assert reader_text("(thesis line 3973)") == "(thesis §3.2.3, p. 176)"
+    assert assumption("G6: kappa = 1e-2 (missing in the thesis)") == \
+        "assumed: kappa = 1e-2 (missing in the thesis)"
+    assert reader_text("see issue 18, sixth session: x") == "see x"
+    assert forbidden(reader_text("--out /work/main/results/a/b.png", [("/work/main", "")])) == []
+    assert figstyle.si_unit("von Mises stress [Pa]", 2.9e7) == ("von Mises stress [MPa]", 1e6)
+    assert figstyle.si_unit("strain [-]", 2e-3) == ("strain [-]", 1.0)

@@ -33,7 +33,7 @@ LOAD_RATE = 4500.0
 EVIDENCE = Reading(
     overrides={"damage_bound": "obstacle"},
     assumptions=[
-        "R1 (evidence reading): each damage step (2.20) is solved as the obstacle problem over "
+        "R1 (evidence reading; supported by the text): each damage step (2.20) is solved as the obstacle problem over "
         "K^h = {zeta_star <= zeta <= 1} (SNES vinewtonrsls; the discrete problem (2.96), line "
         "1566, of Sections 2.2-3.3, with the Section 2.1 source (1.4) unchanged); it differs "
         "from (2.20) only where the linear step leaves [zeta_star, 1]. Thesis: the Section 2.1 "

@@ -50,8 +50,8 @@ def examples():
             assumptions=common_assumptions + [
                 "G2: Gamma_D = inner diamond |x1|+|x2| = 1 (clamped), Gamma_N = circle",
                 "G2: gmsh h = 0.1 (h/2 = 0.05 near the diamond corners), k = 0.01",
-                "G1 (revised) applied to Example 2 as well: kappa = 1 (PROBLEMS.md's example line "
-                "still says 1e-2; G1 supersedes it; override with --set kappa=0.01)"],
+                "G1: kappa = 1 in Example 2 as well (the thesis gives no kappa for Examples 1-2; "
+                "kappa = 1e-2, the value of Example 3, with --set kappa=0.01)"],
             # the mesh (Figure 2.3) is the same for both cases: drawn once, by case a
             figures=([Figure("figure_2_3.png", "Example 2.1-2: setting and mesh", kind="mesh")]
                      if letter == "a" else [])

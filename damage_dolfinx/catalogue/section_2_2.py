@@ -29,7 +29,7 @@ def _params(g_fric, solver="newton"):
 EVIDENCE = Reading(
     traction=lambda x, t: ufl.as_vector((100.0 * (ufl.exp(t) - 1.0), 0.0)),
     assumptions=[
-        "R1 (evidence reading): f_N = (100, 0)(e^t - 1) instead of (100, 0)e^t (thesis line "
+        "R1 (evidence reading; supported by the text): f_N = (100, 0)(e^t - 1) instead of (100, 0)e^t (thesis line "
         "1718), the form Section 3.2 Example 1 prints for the same unit-square setting (line "
         "3973: (200, 0)(e^t - 1)); with u_0 = 0 (line 1720) the load then starts from zero. "
         "Measured (benchmarks/readings.md): literal e^t fully damages the body (zeta_mean 0.01 "

@@ -26,11 +26,11 @@ EVIDENCE_EX1 = Reading(
     traction=lambda x, t: ufl.as_vector((50.0 * (ufl.exp(t) - 1.0), 0.0)),
     overrides={"stress_in_error": "no"},
     assumptions=[
-        "R1 (evidence reading): f_N = (50, 0)(e^t - 1) instead of (50, 0)e^t (line 2747), "
+        "R1 (evidence reading; supported by the text): f_N = (50, 0)(e^t - 1) instead of (50, 0)e^t (line 2747), "
         "the reading of Section 2.2 (R1 there; line 3973 prints (e^t - 1) for the same "
         "unit-square setting); with u_0 = 0, sigma_0 = 0 (line 2747) the load then starts "
         "from zero (G19b's jump disappears)",
-        "R2 (evidence reading): e_hk without ||sigma - sigma_hk||_Q (the formula, line 2751, "
+        "R2 (evidence reading; chosen to match the thesis's results, against the text): e_hk without ||sigma - sigma_hk||_Q (the formula, line 2751, "
         "includes it): the load fixes ||sigma|| ~ 55-137 and the P0 stress error alone is "
         "~67x the thesis's whole e_hk at n = 8 under every reading tried "
         "(benchmarks/readings.md)"])

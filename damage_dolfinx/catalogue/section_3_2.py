@@ -42,7 +42,7 @@ EVIDENCE_EX1 = Reading(
         "thesis size kappa = 1e-2 gives 0.30-0.79x (rate 1.14), 3e-3 gives 0.51-0.81x (median "
         "0.58, rate 1.04 against 1.05); at reduced size 1e-3 gives 0.56-0.81x (rate 0.90 "
         "against 0.95), so Table 3.2 fixes kappa only to a few 1e-3",
-        "R2 (evidence reading): lambda_u = 2000 instead of 1000 (line 3973), the value the "
+        "R2 (evidence reading; taken from another example of the text): lambda_u = 2000 instead of 1000 (line 3973), the value the "
         "thesis states for the next section's convergence example (3.3 Example 1, line 4438). "
         "Without it the error stays 2.5-16x below Table 3.2 whatever kappa (reduced size: "
         "kappa = 1e-2 0.06-0.37x, 3e-3 0.12-0.38x, 1e-3 0.16-0.39x); with it but kappa = 1 the "

@@ -1,29 +1,35 @@
-"""``make report``: one Markdown + HTML report of everything reproduced (results/REPORT.md/.html).
+"""``make report``: one self-contained folder ``<results>/report/`` with REPORT.html (its
+images copied into ``report/images/``), REPORT.md and, with ``--pdf``, REPORT.pdf -- a document
+that still reads and displays when the folder is moved or zipped.
 
-Sources, each traceable to the command that produced it:
-* figures: ``<results>/figures/index.json`` (full mode) or ``figures-quick/index.json``;
-* convergence tables: ``<results>/convergence/<study>/`` if present, else the committed outputs
-  in ``benchmarks/reference_output/convergence/<study>/``;
-* bridge failure load: the figure run of 2.1-ex3 or ``reference_output/bridge``;
-* benchmark records (wall times, performance, friction CPU, per-step floor, 3-D scaling):
-  report_records.py;
-* assumptions: the catalogue (every example's list, with the PROBLEMS.md gap numbers).
-The document: title block with the verdict counts, TOC, summary table (one row per thesis table
-and figure, thesis order: report_figures.py and benchmarks/fidelity.py), known differences,
-benchmarks/readings.md when present, then every section with its figures (full resolution
-preferred, quick ones marked), thesis-beside-ours tables and assumptions. Rendering: report_doc.py.
+Sources (report_sources.py), each traceable to the command that produced it: the figure runs,
+the convergence studies, the thesis tables beside ours (benchmarks/fidelity.py), the bridge
+summary, the benchmark records (report_records.py), every example's assumptions (the
+catalogue). The document: title block with the count of each verdict class, contents, summary
+(one row per thesis table and figure with its graded verdict: report_verdicts.py, checks in
+report_checks.py), known differences, the readings of the thesis data, then every section with
+its figures (full resolution preferred; a quick run's caption says what differs from the full
+run), thesis-beside-ours tables and assumptions. Rendering: report_doc.py; text for a reader
+outside the project (thesis sections instead of line numbers, no internal codes, no machine
+paths): report_text.py.
 """
 from __future__ import annotations
 
 import html
-import json
 import re
+import shutil
 import time
 from pathlib import Path
 
 from damage_dolfinx.report.doc import Doc, _inline
-from damage_dolfinx.report.records import (REFERENCE, REPO, _bridge, _friction_cpu, _performance, _shown,
-                             _status, _step_floor, _threed_scaling, _wall_times)
+from damage_dolfinx.report.records import (REPO, _bridge, _friction_cpu, _performance, _shown, _status,
+                             _step_floor, _threed_scaling, _wall_times)
+from damage_dolfinx.report.sources import (Figures, _bridge_summary, _convergence_png, _fidelity, _load_json,
+                             _study_folder)
+from damage_dolfinx.report.text import assumption, example_ref
+from damage_dolfinx.report.verdicts import (CLASSES, category, headline, known_differences, summary_table,
+                              table_rows)
+
 SECTION_TITLES = {
     "2.1": "Section 2.1: quasistatic elastic body with damage",
     "2.2": "Section 2.2: quasistatic Kelvin-Voigt contact with Tresca friction",
@@ -33,137 +39,59 @@ SECTION_TITLES = {
     "3.2": "Section 3.2: dynamic Kelvin-Voigt contact, bilateral Tresca friction",
     "3.3": "Section 3.3: fully damageable dynamic contact",
 }
+#: the folder ``make report`` writes inside the results folder
+FOLDER = "report"
 
 
-def _load_json(path: Path):
-    return json.loads(path.read_text()) if path.is_file() else None
+def quick_difference(command: str, ex) -> str:
+    """What a quick run changes against the full run of ``ex`` (mesh, time step, final time),
+    read from its command."""
+    opts = dict(re.findall(r"--(n|h|k|T) (\S+)", command))
+    parts = []
+    if "n" in opts and ex.n is not None and int(opts["n"]) != ex.n:
+        parts.append(f"mesh n = {opts['n']} instead of {ex.n}")
+    if "h" in opts and ex.h is not None and float(opts["h"]) != ex.h:
+        parts.append(f"mesh size h = {opts['h']} instead of {ex.h:g}")
+    if "k" in opts and float(opts["k"]) != ex.k:
+        parts.append(f"time step k = {opts['k']} instead of {ex.k:g}")
+    if "T" in opts and float(opts["T"]) != ex.T:
+        parts.append(f"stops at t = {opts['T']} of T = {ex.T:g}")
+    return ", ".join(parts) or "the full run's data"
 
 
-def _figures_index(results: Path):
-    for name in ("figures", "figures-quick"):
-        index = _load_json(results / name / "index.json")
-        if index:
-            return results / name, index
-    return None, None
-
-
-def _study_folder(results: Path, name: str):
-    for folder in (results / "convergence" / name, REFERENCE / "convergence" / name,
-                   REFERENCE / "convergence" / f"{name}-reduced"):
-        if (folder / "errors.md").is_file():
-            return folder
-    return None
-
-
-def _fidelity(results: Path):
-    """benchmarks/fidelity.py's comparison (None if the script is absent, e.g. an installed
-    package without the repository)."""
-    import importlib.util
-    script = REPO / "benchmarks" / "fidelity.py"
-    if not script.is_file():
-        return None
-    spec = importlib.util.spec_from_file_location("damage_dolfinx_fidelity", script)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    result = module.compare(results)
-    module.write(result, results / "fidelity")
-    return result
-
-
-class Figures:
-    """Where each PNG comes from: the full-resolution run if it has it, else the quick run
-    (marked), with the panel data (.npz) of field figures for the verdicts."""
-
-    def __init__(self, results: Path):
-        self.sources = []
-        for name, mode in (("figures", "full"), ("figures-quick", "quick")):
-            index = _load_json(results / name / "index.json")
-            if index:
-                self.sources.append((results / name, index, mode))
-        self.results = results
-
-    def find(self, file):
-        """(png path, mode, npz path or None, index entry) of the best source, or None."""
-        for folder, index, mode in self.sources:
-            if (folder / file).is_file():
-                entry = next((f for f in index["figures"] if f["file"] == file), {})
-                return folder / file, mode, self._npz(folder, index, entry), entry
-        return None
-
-    def _npz(self, folder, index, entry):
-        run = next((r for r in index["runs"] if r["example"] == entry.get("example")
-                    and r["variant"] == entry.get("variant")), None)
-        if run is None or not entry.get("source"):
-            return None
-        for base in (Path(run["folder"]), folder / "runs" / Path(run["folder"]).name):
-            npz = base / Path(entry["source"]).with_suffix(".panel.npz")
-            if npz.is_file():
-                return npz
-        return None
-
-    def run_folder(self, entry):
-        """The run folder behind a figure entry of an index (None if unknown)."""
-        for folder, index, _ in self.sources:
-            run = next((r for r in index["runs"] if r["example"] == entry.get("example")
-                        and r["variant"] == entry.get("variant")), None)
-            if run:
-                for base in (Path(run["folder"]), folder / "runs" / Path(run["folder"]).name):
-                    if base.is_dir():
-                        return base
-        return None
-
-    def runs(self, example):
-        return [(mode, r) for _, index, mode in self.sources[:1] for r in index["runs"]
-                if r["example"] == example]
-
-    def extra(self, example, thesis_files):
-        """Non-thesis PNGs of an example (best source only), without the other variants'
-        copies of a thesis figure (e.g. the Coulomb run's copy of the setting 2.22)."""
-        stems = {re.sub(r"_(tresca|coulomb|undamaged|damaged|a|b)$", "", Path(f).stem)
-                 for f in thesis_files}
-        for folder, index, mode in self.sources[:1]:
-            return [(folder / f["file"], f) for f in index["figures"] if f["example"] == example
-                    and f["file"] not in thesis_files and (folder / f["file"]).is_file()
-                    and re.sub(r"_(tresca|coulomb|undamaged|damaged|a|b)$", "",
-                               Path(f["file"]).stem) not in stems]
+def departures(catalogue, example_id, reading):
+    """The departures from the stated data (``R<n>`` assumptions) of an example under a
+    reading, as the catalogue describes them."""
+    ex = catalogue.get(example_id)
+    if ex is None or not reading or reading == "literal":
         return []
+    return [a for a in (ex.literal or ex).with_reading(reading).assumptions if a.startswith("R")]
 
 
-def _verdict_class(verdict: str) -> str:
-    return "v-reproduced" if verdict.startswith("reproduced") else \
-        "v-differs" if verdict.startswith(("differs", "magnitude", "rate")) else "v-not"
-
-
-def _category(verdict: str) -> str:
-    return {"v-reproduced": "reproduced", "v-differs": "differs"}.get(
-        _verdict_class(verdict), "not comparable")
-
-
-def _convergence_png(results: Path, example, variant):
-    name = example + (f"-{variant}" if variant else "")
-    folder = _study_folder(results, name)
-    return folder / "convergence.png" if folder and (folder / "convergence.png").is_file() else None
-
-
-def _bridge_summary(results: Path):
-    for path in (results / "figures" / "runs" / "bridge_collapse" / "bridge_summary.json",
-                 results / "figures-quick" / "runs" / "bridge_collapse" / "bridge_summary.json",
-                 REFERENCE / "bridge" / "bridge_summary.json"):
-        s = _load_json(path)
-        if s:
-            return s, path
-    return None, None
+def _setting_verdict(ex):
+    """A setting figure: reproduced, unless its geometry or boundary layout is assumed."""
+    layout = [a for a in ex.literal.assumptions if re.match(
+        r"(?:[\d.]+/)?G\d+[\w/]*:\s*(?:Gamma_[DNC] =|Omega =|geometry|cantilever|semicircular)", a)]
+    if not layout:
+        return "reproduced", "the setting as stated in the text"
+    return ("setting assumed: " + "; ".join(assumption(a).removeprefix("assumed: ")
+                                            for a in layout)), "our assumed layout"
 
 
 def build(results: Path) -> Path:
-    """Write results/REPORT.md and results/REPORT.html; returns the HTML path."""
+    """Write ``<results>/report/`` (REPORT.html with its images, REPORT.md); returns the HTML
+    path."""
     from damage_dolfinx.catalogue import examples
     from damage_dolfinx.report import reproduce
-    from damage_dolfinx.report.figures import THESIS_FIGURES, judge, run_context
+    from damage_dolfinx.report.checks import judge, run_context
+    from damage_dolfinx.report.figures import THESIS_FIGURES
     results = Path(results).resolve()
-    results.mkdir(parents=True, exist_ok=True)
-    doc = Doc(results)
-    catalogue = examples.catalogue()
+    folder = results / FOLDER
+    if folder.exists():
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True)
+    doc = Doc(folder, roots=[(results, results.name), (REPO, "")])
+    catalogue = {k: ex.with_reading() for k, ex in examples.catalogue().items()}
     figs = Figures(results)
     fidelity = _fidelity(results) or {"tables": []}
     conv_index = _load_json(results / "convergence" / "index.json") or {}
@@ -172,27 +100,15 @@ def build(results: Path) -> Path:
     readings = REPO / "benchmarks" / "readings.md"
 
     # ---- verdicts of every thesis figure and table (rows of the summary, thesis order)
-    rows = []
-    for t in fidelity["tables"]:
-        got = (f"median ratio ours/thesis {t['ratio_median']:.3g} (min {t['ratio_min']:.3g}, max "
-               f"{t['ratio_max']:.3g}) over {t['n_common']} cells; rate {t['rate_ours']:.2f} vs "
-               f"{t['rate_thesis_common_cells']:.2f}" if "ratio_median" in t else "no study")
-        rows.append(dict(key=_sort_key(t["table"], 0), item=f"Table {t['table']}",
-                         anchor=f"table-{t['table'].replace('.', '-')}", example=t.get("study", ""),
-                         shows=f"errors of {t['example']} ({t.get('thesis_norm', '')})", got=got,
-                         verdict=t["verdict"]))
-    for number, study in (("2.1", "2.1-ex1"), ("3.3", "3.3-ex1")):
-        folder = _study_folder(results, study)
-        rate = ((_load_json(folder / "summary.json") or {}).get("rates", {}).get("h_plus_k_all")
-                if folder else None)
-        rows.append(dict(key=_sort_key(number, 0), item=f"Table {number}", anchor=f"study-{study}",
-                         example=study, shows="errors (withheld from us on purpose: a control)",
-                         got=f"our study: rate {rate:.2f} in h + k" if rate else "no study",
-                         verdict="not comparable (thesis table withheld)"))
-    table_verdicts = {t["table"]: t["verdict"] for t in fidelity["tables"]}
+    for t in fidelity["tables"]:  # the departures as the catalogue describes them
+        if t.get("departures"):
+            t["departures"] = departures(catalogue, t["example"].split()[0], t.get("reading"))
+    rows = table_rows(fidelity, results, _study_folder, _load_json, _sort_key)
+    table_verdicts = {t["table"]: r["verdict"] for t, r in zip(fidelity["tables"], rows)}
     conv_table = {"2.11": "2.4", "2.15": "2.5", "2.23": "2.6", "3.2": "3.1"}
     figure_blocks = {}
     for fig in THESIS_FIGURES:
+        ex = catalogue.get(fig.example)
         found = [figs.find(f) for f in fig.files]
         paths = [(f[0], f[1]) for f in found if f]
         if fig.kind == "convergence":
@@ -203,67 +119,101 @@ def build(results: Path) -> Path:
                 verdict = table_verdicts.get(conv_table[fig.number], "not comparable")
                 got = f"as Table {conv_table[fig.number]}"
                 if fig.number == "2.23":
-                    verdict = table_verdicts.get("2.6", "") + " / " + table_verdicts.get("2.7", "")
-                    verdict = "reproduced" if verdict == "reproduced / reproduced" else \
-                        "differs: " + verdict
+                    both = [table_verdicts.get(t, "not comparable") for t in ("2.6", "2.7")]
+                    verdict = both[0] if category(both[0]) == category(both[1]) else \
+                        min(both, key=lambda v: -CLASSES.index(category(v)))
+                    got = "as Tables 2.6 (Tresca) and 2.7 (Coulomb)"
             else:
-                verdict, got = "not comparable (thesis table withheld)", "our convergence plot"
+                verdict, got = ("not comparable: our convergence plot alone (see the table "
+                                "row)"), "our convergence plot"
+        elif fig.kind == "setting":
+            verdict, got = _setting_verdict(ex)
+        elif fig.kind == "assumed-setting":
+            verdict, got = ("setting assumed: the thesis shows a sketch without dimensions; "
+                            "ours is an assumed geometry"), "our assumed geometry"
         else:
             context = run_context(figs.run_folder(found[0][3]) if found and found[0] else None)
+            context["T_full"] = ex.T if ex else None
+            command = found[0][3].get("command", "") if found and found[0] else ""
+            stop = re.search(r"--T (\S+)", command)
+            context["T_run"] = float(stop.group(1)) if stop else None
+            context["departures"] = departures(catalogue, fig.example, context.get("reading"))
             if bridge and fig.example == "2.1-ex3":
                 context.update(hinges=bridge.get("n_mechanism_hinges", bridge.get("n_hinges")),
                                failure_load_kN=bridge.get("failure_load_kN"))
-            verdict, got, failed = judge(fig, [f[2] if f else None for f in found], context)
-            if not paths:
-                verdict, got = "not comparable (not produced: run `make figures`)", "-"
-            elif failed:
-                verdict = "differs: " + "; ".join(f"not {x}" for x in failed)
-        quick = any(mode == "quick" for _, mode in paths)
-        if quick:
-            got += " [quick run: coarse mesh]"
+            related = [r[2] if r else None for r in (figs.find(f) for f in fig.related)]
+            verdict, got, _ = judge(fig, [f[2] if f else None for f in found], related, context)
+        if not paths:
+            verdict, got = "not comparable: not produced (run `make figures`)", "-"
+        quick = any(mode == "quick" for _, mode in paths) and bool(found and found[0])
+        if quick and ex:
+            got += f" [quick run: {quick_difference(found[0][3].get('command', ''), ex)}]"
         rows.append(dict(key=_sort_key(fig.number, 1), item=f"Figure {fig.number}",
                          anchor=fig.anchor, example=fig.example,
-                         shows=f"{fig.shows} (thesis lines {fig.lines})", got=got, verdict=verdict))
+                         shows=f"{fig.shows} ({example_ref(fig.example)})", got=got,
+                         verdict=verdict))
         figure_blocks.setdefault(fig.example, []).append((fig, paths, got, verdict, quick))
     rows.sort(key=lambda r: r["key"])
-    counts = {c: sum(_category(r["verdict"]) == c for r in rows)
-              for c in ("reproduced", "differs", "not comparable")}
+    counts = {c: sum(category(r["verdict"]) == c for r in rows) for c in CLASSES}
+    _title(doc, figs, counts, len(rows))
+    _contents(doc, readings)
+    summary_table(doc, rows, fidelity)
+    known_differences(doc, rows)
+    if readings.is_file():
+        doc.anchor_heading(2, "Readings of the thesis data", "readings")
+        doc.para("Where the stated data of an example do not reproduce the thesis's results, a "
+                 "*reading* changes as little as possible and is compared with the stated data "
+                 "(`benchmarks/readings.md`).")
+        doc.markdown_table(readings.read_text())
+    _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_commands, bridge,
+              bridge_path, reproduce)
+    _wall_times(doc, figs.sources[0][1] if figs.sources else None, conv_index)
+    _performance(doc, results)
+    _step_floor(doc)
+    _threed_scaling(doc)
+    (folder / "REPORT.md").write_text(doc.to_markdown())
+    page = folder / "REPORT.html"
+    page.write_text(doc.to_html("damage-dolfinx: reproduction of Campo (2007)"))
+    return page
 
-    # ---- title block, summary, TOC
-    fig_modes = ", ".join(f"`{folder.name}` ({index['mode']}, {index['mpi_size']} ranks, "
-                          f"{index.get('wall_time_s', '?')} s)" for folder, index, _ in figs.sources)
+
+def _title(doc, figs, counts, total):
+    fig_modes = ", ".join(f"{index['mode']} figure runs on {index['mpi_size']} MPI ranks "
+                          f"({index.get('wall_time_s', '?')} s)" for _, index, _ in figs.sources[:1])
+    quick = figs.sources and figs.sources[0][2] == "quick"
+    lines = "".join(f'<li class="{c}">{counts[c]} {html.escape(c)}</li>' for c in CLASSES)
     doc.raw(f'<header class="title"><h1>damage-dolfinx: reproduction of M. Campo (2007)</h1>'
-            f"<p>Numerical analysis and simulation of quasistatic and dynamic contact problems "
-            f"with damage — every thesis figure and error table recomputed with DOLFINx and "
-            f"set beside the thesis.<br>Generated {time.strftime('%Y-%m-%d %H:%M')} by "
-            f"<code>make report</code> from <code>{html.escape(str(results))}</code>. Figures: "
-            f"{_inline(fig_modes or 'none yet (run make figures)')}. Thesis tables: "
-            f"<code>{html.escape(fidelity.get('tables_file', '-'))}</code>.</p>"
-            f"<p><b>{counts['reproduced']} reproduced, {counts['differs']} differ, "
-            f"{counts['not comparable']} not comparable</b> (of {len(rows)} thesis tables and "
-            f"figures).</p></header>",
+            f"<p>M. Campo, <i>Numerical analysis and simulation of quasistatic and dynamic "
+            f"contact problems with damage</i>, PhD thesis, Universidade de Santiago de "
+            f"Compostela, 2007: every thesis figure and error table recomputed with DOLFINx and "
+            f"set beside the thesis. Thesis references give the thesis's section, page and "
+            f"example.<br>Generated {time.strftime('%Y-%m-%d %H:%M')} by <code>make report</code>; "
+            f"figures: {html.escape(fig_modes or 'none yet (run make figures)')}"
+            + (" — <b>coarse quick runs</b>: each caption says what differs from the full run"
+               if quick else "") + ".</p>"
+            f'<p><b>Verdicts of the {total} thesis tables and figures:</b></p>'
+            f'<ul class="counts">{lines}</ul></header>',
             f"# damage-dolfinx: reproduction of M. Campo (2007)\n\nGenerated "
-            f"{time.strftime('%Y-%m-%d %H:%M')} from `{results}`. Figures: {fig_modes or 'none'}."
-            f"\n\n**{counts['reproduced']} reproduced, {counts['differs']} differ, "
-            f"{counts['not comparable']} not comparable** (of {len(rows)}).")
+            f"{time.strftime('%Y-%m-%d %H:%M')}; figures: {fig_modes or 'none'}."
+            f"\n\n**{headline(counts)}** (of {total}).")
+
+
+def _contents(doc, readings):
     toc = [("summary", "Summary: every thesis table and figure"),
            ("differences", "Known differences")]
     if readings.is_file():
-        toc.append(("readings", "Readings of the thesis data (benchmarks/readings.md)"))
+        toc.append(("readings", "Readings of the thesis data"))
     toc += [(f"sec-{s.replace('.', '-')}", t) for s, t in SECTION_TITLES.items()]
     toc += [("wall-times", "Wall times"), ("performance", "Performance"),
             ("step-floor", "Per-step cost against its floor"), ("scaling-3d", "3-D scaling")]
     doc.raw('<nav class="toc"><h2 class="first" id="contents">Contents</h2><ol>'
             + "".join(f'<li><a href="#{a}">{html.escape(t)}</a></li>' for a, t in toc)
             + "</ol></nav>", "\n".join(f"- [{t}](#{a})" for a, t in toc))
-    _summary_table(doc, rows, fidelity)
-    _known_differences(doc, rows)
-    if readings.is_file():
-        doc.anchor_heading(2, "Readings of the thesis data", "readings")
-        doc.para(f"From `{_shown(readings)}` (per-example data readings and verdicts).")
-        doc.markdown_table(readings.read_text())
 
-    # ---- sections in thesis order
+
+def _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_commands, bridge,
+              bridge_path, reproduce):
+    """Every thesis section: its examples' runs, figures, tables and assumptions."""
     by_table = {t.get("study"): t for t in fidelity["tables"]}
     for section, title in SECTION_TITLES.items():
         exs = [ex for ex in catalogue.values() if ex.section == section]
@@ -274,7 +224,9 @@ def build(results: Path) -> Path:
             doc.anchor_heading(3, f"{ex.id}: {ex.title}", f"ex-{ex.id}")
             for mode, run in figs.runs(ex.id):
                 doc.para(f"Run{' (' + run['variant'] + ')' if run['variant'] else ''}: "
-                         f"`{run['command']}` ({_status(run)}, {run['wall_time_s']} s)")
+                         f"`{run['command']}` ({_status(run)}, {run['wall_time_s']} s)"
+                         + (f"; quick run: {quick_difference(run['command'], ex)}"
+                            if mode == "quick" else ""))
             thesis_files = set()
             for fig, paths, got, verdict, quick in figure_blocks.get(ex.id, []):
                 thesis_files.update(fig.files)
@@ -283,11 +235,11 @@ def build(results: Path) -> Path:
                             f"in this reproduction ({_inline(verdict)}).</p>",
                             f"**Figure {fig.number}**: not produced.")
                     continue
+                quote = f" Thesis: “{fig.quote}”" if fig.quote else ""
                 doc.figure([p for p, _ in paths],
-                           f"**Figure {fig.number}** (thesis lines {fig.lines}). Thesis: "
-                           f"{fig.shows}. Ours: {got}. Verdict: **{verdict}**."
-                           + (" *Quick run (coarse mesh) shown: no full-resolution figure in this "
-                              "reproduction.*" if quick else ""), fig.anchor)
+                           f"**Figure {fig.number}** ({example_ref(fig.example)}): "
+                           f"{fig.shows}.{quote} Ours: {got}. Verdict: **{verdict}**.",
+                           fig.anchor)
             for path, entry in figs.extra(ex.id, thesis_files):
                 doc.image(path, f"Not a thesis figure: {entry['file']} "
                                 f"({entry.get('variant') or 'final state'}).")
@@ -301,16 +253,10 @@ def build(results: Path) -> Path:
                 _bridge(doc, bridge, bridge_path)
             if ex.id == "2.2-ex1":
                 _friction_cpu(doc)
-            doc.para("**Assumptions** (PROBLEMS.md gap numbers):")
-            doc.items(ex.assumptions)
-    _wall_times(doc, figs.sources[0][1] if figs.sources else None, conv_index)
-    _performance(doc, results)
-    _step_floor(doc)
-    _threed_scaling(doc)
-    md, page = results / "REPORT.md", results / "REPORT.html"
-    md.write_text(doc.to_markdown())
-    page.write_text(doc.to_html("damage-dolfinx: reproduction of Campo (2007)"))
-    return page
+            doc.para("**Assumptions**: *assumed* = a value or layout the thesis does not give; "
+                     "*reading* = a departure from the stated data (fitted, or taken from "
+                     "another place of the text).")
+            doc.items(assumption(a) for a in ex.assumptions)
 
 
 #: a thesis table sits in the summary right after the figure it belongs to
@@ -325,43 +271,6 @@ def _sort_key(number: str, kind: int):
         return (int(a), int(b), 1, number)
     a, b = number.split(".")
     return (int(a), int(b), 0, "")
-
-
-def _summary_table(doc, rows, fidelity):
-    doc.anchor_heading(2, "Summary: every thesis table and figure", "summary")
-    doc.para("One row per thesis table and figure, in thesis order. *Thesis* is what the thesis "
-             "text says the item shows (thesis.txt line numbers); *ours* is measured on our "
-             "output (tables: benchmarks/fidelity.py; figures: the figure's own data); the verdict "
-             "rule is stated under the table.")
-    body = "".join(
-        f'<tr><td class="l"><a href="#{r["anchor"]}">{html.escape(r["item"])}</a></td>'
-        f'<td class="l">{html.escape(r["example"])}</td><td class="l">{_inline(r["shows"])}</td>'
-        f'<td class="l">{_inline(r["got"])}</td>'
-        f'<td class="l {_verdict_class(r["verdict"])}">{_inline(r["verdict"])}</td></tr>'
-        for r in rows)
-    md = "| item | example | thesis | ours | verdict |\n|---|---|---|---|---|\n" + "".join(
-        f"| [{r['item']}](#{r['anchor']}) | {r['example']} | {r['shows']} | {r['got']} | "
-        f"{r['verdict']} |\n" for r in rows)
-    doc.raw('<table class="summary"><tr><th class="l">item</th><th class="l">example</th>'
-            '<th class="l">what the thesis shows</th><th class="l">what we get</th>'
-            f'<th class="l">verdict</th></tr>{body}</table>', md)
-    doc.note("Tables: " + fidelity.get("criteria", "") + ". Figures: *reproduced* when every "
-             "check derived from the thesis sentence holds on our figure's data (listed in the "
-             "'differs' verdicts when one fails); settings are reproduced when geometry and "
-             "boundary parts are the stated ones; *not comparable*: no measurable statement, a "
-             "withheld table, an assumed geometry or no output.")
-
-
-def _known_differences(doc, rows):
-    doc.anchor_heading(2, "Known differences", "differences")
-    differ = [r for r in rows if _category(r["verdict"]) == "differs"]
-    if not differ:
-        doc.para("None: every comparable item is reproduced.")
-        return
-    doc.items(f"[{r['item']}](#{r['anchor']}) ({r['example']}): {r['verdict']}. Ours: {r['got']}."
-              for r in differ)
-    doc.para("The open readings of the thesis data behind these differences (loads, damage "
-             "data, norms) are studied in issue 16; see the readings section when present.")
 
 
 def _fidelity_table(doc, t):
@@ -386,7 +295,7 @@ def _fidelity_table(doc, t):
         body += f"<tr><th>{n}</th>{cells}</tr>"
     doc.anchor_heading(4, f"Table {t['table']} (thesis) beside ours: {t['study']}", anchor)
     doc.raw(f"<table><tr><th>n \\ k</th>{head}</tr>{body}</table>",
-            f"Table {t['table']}: see fidelity.md")
+            markdown_cells(t))
     comp = ", ".join(f"{k} {v:.3g}" for k, v in t.get("component_medians", {}).items())
     doc.note(f"Each cell: **ratio ours / thesis** (green within [0.5, 2]), below it thesis / ours. "
              f"Thesis norm: {t['thesis_norm']}; ours: {t['our_error']} (reference n, k: thesis "
@@ -395,6 +304,20 @@ def _fidelity_table(doc, t):
              f"rate in h + k: thesis {t['rate_thesis_common_cells']:.3f}, ours {t['rate_ours']:.3f}."
              + (f" Median ratio of our error components alone: {comp}." if comp else "")
              + f" Source: {t['source']} (`{_shown(Path(t['folder']))}`). Verdict: **{t['verdict']}**.")
+
+
+def markdown_cells(t) -> str:
+    """The thesis-beside-ours table in Markdown (ratio, thesis / ours per cell)."""
+    ks = t["k"]
+    rows = {}
+    for c in t["cells"]:
+        rows.setdefault(c["n"], {})[c["k"]] = c
+    cell = lambda c: (f"**{c['ratio']:.3g}** ({c['thesis']:.4g} / {c['ours']:.4g})"  # noqa: E731
+                      if "ratio" in c else f"- ({c.get('thesis', 0):.4g} / -)")
+    return (f"| n \\ k | " + " | ".join(f"k = {k:g}" for k in ks) + " |\n|---"
+            + "|---" * len(ks) + "|\n" + "".join(
+                f"| {n} | " + " | ".join(cell(rows[n].get(float(k), {})) for k in ks) + " |\n"
+                for n in sorted(rows)))
 
 
 def _convergence_of(doc, results, example_id, variant, commands, full=True):

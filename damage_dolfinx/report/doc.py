@@ -1,19 +1,42 @@
 """Markdown + HTML rendering of the report (report.py): blocks rendered both ways, a minimal
 Markdown-table reader, the page template (print CSS, and the load script the test suite reads
-in headless Chromium). No Markdown library needed."""
+in headless Chromium). No Markdown library needed.
+
+Every image is copied into ``<folder>/images/`` and linked relative to the folder, so the folder
+can be moved or zipped; every text goes through report_text.reader_text (no machine paths, no
+thesis line numbers, no development history)."""
 from __future__ import annotations
 
 import html
-import os
 import re
+import shutil
 from pathlib import Path
+
+from damage_dolfinx.report.text import reader_text
 
 
 class Doc:
     """Blocks rendered both as Markdown and as HTML."""
 
-    def __init__(self, base: Path):
-        self.base, self.blocks = base, []
+    def __init__(self, base: Path, roots=()):
+        self.base, self.blocks, self.roots, self.copied = base, [], list(roots), {}
+
+    def _copy(self, path: Path) -> str:
+        """Copy an image into ``images/`` (a name made unique from its folders); its link."""
+        path = Path(path).resolve()
+        if path not in self.copied:
+            for root, _ in self.roots:
+                if Path(root) in path.parents:
+                    rel = path.relative_to(root)
+                    break
+            else:
+                rel = Path(path.name)
+            name = "_".join(p for p in rel.parts if p not in ("runs", "reference_output"))
+            target = self.base / "images" / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy(path, target)
+            self.copied[path] = f"images/{name}"
+        return self.copied[path]
 
     def heading(self, level, text):
         self.blocks.append(("h", level, text))
@@ -25,11 +48,11 @@ class Doc:
         self.blocks.append(("code", text))
 
     def image(self, path: Path, caption):
-        self.blocks.append(("img", os.path.relpath(path, self.base), caption))
+        self.blocks.append(("img", self._copy(path), caption))
 
     def figure(self, paths, caption, anchor):
         """One thesis figure: its PNG(s) side by side, an anchor and a caption."""
-        self.blocks.append(("fig", [os.path.relpath(p, self.base) for p in paths], caption, anchor))
+        self.blocks.append(("fig", [self._copy(p) for p in paths], caption, anchor))
 
     def anchor_heading(self, level, text, anchor):
         self.blocks.append(("ah", level, text, anchor))
@@ -73,7 +96,7 @@ class Doc:
                 out.append(b[2])
             elif b[0] == "note":
                 out.append(f"*{b[1]}*")
-        return "\n\n".join(out) + "\n"
+        return reader_text("\n\n".join(out) + "\n", self.roots)
 
     def to_html(self, title) -> str:
         body = []
@@ -102,7 +125,8 @@ class Doc:
                 body.append(b[1])
             elif b[0] == "note":
                 body.append(f'<p class="note">{_inline(b[1])}</p>')
-        return HTML_TEMPLATE.format(title=html.escape(title), body="\n".join(body))
+        return HTML_TEMPLATE.format(title=html.escape(title),
+                                    body=reader_text("\n".join(body), self.roots))
 
 
 def _inline(text) -> str:
@@ -209,10 +233,15 @@ table.summary td {{ text-align: left; }}
 .v-reproduced {{ color: #1a7f37; font-weight: bold; }}
 .v-differs {{ color: #b3261e; font-weight: bold; }}
 .v-not {{ color: #666; font-weight: bold; }}
+.v-reading {{ color: #2f6f3a; font-weight: bold; }}
+.v-assumed {{ color: #8a6d00; font-weight: bold; }}
+.v-invisible {{ color: #a04f00; font-weight: bold; }}
+ul.counts {{ columns: 3; list-style: none; padding-left: 0; font-weight: bold; }}
+nav.toc li {{ break-inside: avoid; }}
 td.ratio small {{ color: #555; display: block; font-size: 80%; }}
 td.good {{ background: #e6f4ea; }} td.bad {{ background: #fce8e6; }}
 p.note {{ font-size: 85%; color: #444; margin-top: -0.3em; }}
-nav.toc ol {{ columns: 2; font-size: 92%; }}
+nav.toc ol {{ columns: 2; column-gap: 3.5em; font-size: 92%; }}
 pre {{ background: #f4f4f4; padding: 0.5em; overflow-x: auto; white-space: pre-wrap; }}
 ul.assumptions {{ font-size: 82%; color: #333; }}
 h2 {{ border-bottom: 1px solid #999; break-after: avoid; }} h3, h4 {{ break-after: avoid; }}

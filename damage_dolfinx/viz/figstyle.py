@@ -141,7 +141,7 @@ def plt():
     matplotlib.use("Agg")
     import matplotlib.pyplot as pyplot
     pyplot.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
-                            "mathtext.fontset": "dejavusans"})
+                            "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False})
     return pyplot
 
 
@@ -169,6 +169,27 @@ def colorbar(fig, ax, mappable, label, ticks=None):
     cb.set_label(label, fontsize=8.5)
     cb.ax.tick_params(labelsize=7.5)
     return cb
+
+
+#: SI prefixes a stress scale is written in (never a "1e6" multiplier over the colour bar)
+SI_PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""))
+
+
+def si_unit(label: str, vmax: float):
+    """(label, scale): a label ending in a unit ``[Pa]`` (or ``[N]``, ``[m]`` ...) rewritten
+    with the SI prefix that keeps the largest value below 1000 (``[MPa]``, scale 1e6); other
+    labels unchanged (scale 1)."""
+    m = re.search(r"\[(Pa|N|N/m|N/m\^?2|J)\]$", label)
+    if not m or not vmax or not math.isfinite(vmax):
+        return label, 1.0
+    scale, prefix = next(((f, p) for f, p in SI_PREFIXES if abs(vmax) >= f), (1.0, ""))
+    return label[:m.start()] + f"[{prefix}{m.group(1)}]", scale
+
+
+def plain_ticks(axis, scale=1.0):
+    """Tick labels ``value / scale`` written out in full (``%g``): no offset, no multiplier."""
+    from matplotlib.ticker import FuncFormatter
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v / scale:.4g}"))
 
 
 def damage_ticks(vmin, vmax, zeta_star):
@@ -231,10 +252,14 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     pyplot = plt()
     nplot = len(panels) if not mesh_only or all("title" in p for p in panels) else 1
     allxy = [p["xy"] for p in panels] + ([ref_xy] if ref_xy is not None else [])
-    fig, axes = new_figure(nplot, data_aspect(np.concatenate([np.asarray(x).reshape(-1, 2)
-                                                               for x in allxy])))
-    used, notes = [], []
-    for i, ax in enumerate(axes):
+    extra = 0 if mesh_only or zeta_star is None else sum(
+        is_damage(p.get("name", ""), p.get("label", ""))
+        and narrow_damage(float(np.nanmin(p["values"])), float(np.nanmax(p["values"])), zeta_star)
+        for p in panels[:nplot])
+    fig, axes = new_figure(nplot + extra, data_aspect(np.concatenate(
+        [np.asarray(x).reshape(-1, 2) for x in allxy])))
+    used, notes, stretched = [], [], []
+    for i, ax in enumerate(axes[:nplot]):
         p = panels[i]
         xy, vals = np.asarray(p["xy"]), np.asarray(p["values"])
         if mesh_only:
@@ -257,25 +282,67 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
             else:
                 im = ax.tripcolor(tri, facecolors=vals, cmap=cmap, vmin=vmin, vmax=vmax)
             ticks = damage_ticks(vmin, vmax, zeta_star) if damage and zeta_star is not None else None
+            label, scale = si_unit(label, vmax) if not damage else (label, 1.0)
             cb = colorbar(fig, ax, im, label, ticks)
             if not ticks:
-                cb.formatter.set_powerlimits((-3, 4))
-                cb.update_ticks()
+                plain_ticks(cb.ax.yaxis, scale)
             if damage:
-                ax.set_title(p.get("title", "damage $\\zeta$") + (f"\n{note}" if note else ""),
+                lo, hi = float(np.nanmin(vals)), float(np.nanmax(vals))
+                faint = zeta_star is not None and narrow_damage(lo, hi, zeta_star)
+                if faint:  # the range of the field, on the fixed bar
+                    cb.ax.axhspan(lo, hi, xmin=0, xmax=1, facecolor="none", edgecolor="red", lw=1.2)
+                ax.set_title(p.get("title", "damage $\\zeta$") + (f"\n{note}" if note else
+                             f"\n$\\zeta$ in [{lo:.3g}, {hi:.3g}]"),
                              color="firebrick" if note else "k")
+                if faint:
+                    stretched.append((ax, tri, vals, lo, hi))
             else:
                 ax.set_title(p.get("title", re.sub(r"\s*\[[^]]*\]$", "", label)))
             used.append((vmin, vmax))
         if ref_xy is not None:
             draw_outline(ax, np.asarray(ref_xy))
         _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else []))
+    for ax, (src, tri, vals, lo, hi) in zip(axes[nplot:], stretched):
+        _stretched_damage(fig, ax, tri, vals, lo, hi)
+        if ref_xy is not None:
+            draw_outline(ax, np.asarray(ref_xy))
+        ax.set_xlim(src.get_xlim())
+        ax.set_ylim(src.get_ylim())
+        ax.set_aspect("equal")
+        ax.set_xlabel(src.get_xlabel())
     full = mathtext(title) + f" — {amplification_text(amplification)}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
     fig.savefig(path, dpi=DPI, bbox_inches="tight")
     pyplot.close(fig)
     return used
+
+
+#: a damage field whose range covers less than this fraction of [zeta*, 1] is one colour on the
+#: fixed scale: the figure adds a panel on the field's own range (red frame on the fixed bar)
+NARROW_DAMAGE = 0.25
+
+
+def narrow_damage(lo: float, hi: float, zeta_star: float) -> bool:
+    """True when the damage range [lo, hi] is too narrow to be seen on the fixed [zeta*, 1]
+    scale but not constant (a constant field has nothing to stretch)."""
+    return hi - lo < NARROW_DAMAGE * (1 - zeta_star) and hi - lo > 1e-6
+
+
+def _stretched_damage(fig, ax, tri, vals, lo, hi):
+    """The same damage field on a colour scale stretched to its own range [lo, hi]."""
+    if vals.ndim == 2:
+        im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap=STRETCHED_CMAP,
+                          vmin=lo, vmax=hi)
+    else:
+        im = ax.tripcolor(tri, facecolors=vals, cmap=STRETCHED_CMAP, vmin=lo, vmax=hi)
+    cb = colorbar(fig, ax, im, "$\\zeta$ (scale: range of the field)")
+    plain_ticks(cb.ax.yaxis)
+    ax.set_title(f"the same damage, colours stretched\nto its range [{lo:.3g}, {hi:.3g}]")
+
+
+#: colour map of the stretched damage panel (distinct from the fixed one: not to be compared)
+STRETCHED_CMAP = "cividis"
 
 
 def suptitle_on_top(fig, text):

@@ -300,7 +300,14 @@ def _strongest_load(expr, constants, t_const, times, points):
              for t in times]
     if not peaks or max(peaks) == 0.0:
         return None, None
-    t = float(times[len(peaks) - 1 - int(np.argmax(peaks[::-1]))])  # the last time of the peak
+    # the end of the first stretch at the peak: a periodic load is drawn in its first half
+    # period (3.1-ex2 pushes toward the obstacle at t = 0.25 and pulls at t = 0.75), a load held
+    # on a plateau at the plateau's end (2.3-ex3: t = 0.5)
+    at_peak = np.asarray(peaks) >= max(peaks) * (1 - 1e-9)
+    i = int(np.argmax(at_peak))
+    while i + 1 < len(at_peak) and at_peak[i + 1]:
+        i += 1
+    t = float(times[i])
     return ("constant" if max(peaks) - min(peaks) <= 1e-12 * max(peaks) else t), values(t, points)
 
 
@@ -331,7 +338,9 @@ def plot_history(csv_path, columns, path, title=""):
                                 sharex=True, squeeze=False)
     for ax, (column, label) in zip(axes[:, 0], columns):
         ax.plot(t, [float(r[column]) if r[column] else np.nan for r in rows], lw=1.2)
+        label, scale = figstyle.si_unit(label, np.nanmax(np.abs(ax.get_ylim())))
         ax.set_ylabel(figstyle.mathtext(label))
+        figstyle.plain_ticks(ax.yaxis, scale)  # every tick written out: no '1e-11' multiplier
         ax.grid(True, alpha=0.3)
         if "zeta" in column:
             ax.set_ylim(0, 1.05)

@@ -1,0 +1,322 @@
+"""Measurements on a figure's own data and the graded verdict of each thesis figure.
+
+A figure's data are the ``.panel.npz`` post.plot_fields saves beside it (undeformed and deformed
+vertex coordinates, stress and damage per vertex) and its run's ``history.csv`` and
+``summary.json``. Each check of report_figures.THESIS_FIGURES tests the quantity the quoted
+thesis sentence is about; :func:`judge` grades the figure (report_verdicts.CLASSES):
+
+* *not visible in this figure* when the statement is about the damage and the damage is one
+  colour on the thesis's fixed scale [zeta*, 1] (range below 25 % of it; the figure then adds a
+  panel on the field's own range) or did not develop at all;
+* *differs* when a check fails (the failed checks are named);
+* *reproduced under a reading* when every check holds on a run that departs from the stated
+  data (each departure named, fitted or taken from the text);
+* *not comparable* when nothing the sentence says can be measured, or the run stops before the
+  time the sentence is about (quick runs);
+* *reproduced* otherwise.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from damage_dolfinx.viz.figstyle import NARROW_DAMAGE, load_panels
+
+#: a damage field within 1e-3 of 1 everywhere has not developed (nothing to locate)
+NO_DAMAGE = 1e-3
+#: rank correlation above which two fields "coincide" / "correspond"
+RANK_AGREE = 0.5
+#: rank correlation above which two runs' fields have the same pattern
+RANK_SAME = 0.8
+
+
+def fields(npz) -> dict:
+    """Undeformed vertex coordinates, displacements, stress and damage of one figure's data."""
+    panels, meta, ref = load_panels(npz)
+    out = {"meta": meta}
+    for p in panels:
+        xy = np.asarray(p["xy"]).reshape(-1, 2)
+        base = np.asarray(ref).reshape(-1, 2) if ref is not None else xy
+        vals = np.asarray(p["values"])
+        vals = vals.reshape(-1) if vals.ndim == 2 else np.repeat(vals, 3)
+        amp = meta.get("amplification") or 1.0
+        out.setdefault("base", base)
+        out.setdefault("disp", (xy - base) / amp)
+        key = "zeta" if p.get("name") == "zeta" or "zeta" in p.get("label", "") else "stress"
+        out.setdefault(key, vals)
+    return out
+
+
+def rank_correlation(a, b) -> float:
+    from scipy.stats import spearmanr
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    if np.ptp(a) == 0 or np.ptp(b) == 0:
+        return float("nan")
+    return float(spearmanr(a, b).correlation)
+
+
+def on_same_points(src: dict, dst: dict, key: str):
+    """``src[key]`` at the vertices of ``dst`` (nearest undeformed vertex: two runs on one mesh,
+    or two figures of one run)."""
+    from scipy.spatial import cKDTree
+    _, idx = cKDTree(src["base"]).query(dst["base"])
+    return src[key][idx]
+
+
+def _rel(base, i):
+    lo, hi = base.min(0), base.max(0)
+    return ((base[i] - lo) / np.where(hi > lo, hi - lo, 1)).tolist()
+
+
+def quadrant(rel) -> str:
+    x, y = rel
+    return ("lower" if y < 1 / 3 else "upper" if y > 2 / 3 else "middle") + " " + \
+        ("left" if x < 1 / 3 else "right" if x > 2 / 3 else "centre")
+
+
+def measure(npz, related=()) -> dict:
+    """Numbers the checks need, from one figure's data (and its related figures' data)."""
+    f = fields(npz)
+    base, meta = f["base"], f["meta"]
+    m = {"amplification": meta.get("amplification"), "zeta_star": meta.get("zeta_star") or 0.01}
+    d = np.linalg.norm(f["disp"], axis=1)
+    dmax = float(d.max()) or 1.0
+    rel = (base - base.min(0)) / np.where(np.ptp(base, 0) > 0, np.ptp(base, 0), 1)
+    m.update(u_max=float(d.max()), size=float(np.hypot(*np.ptp(base, 0))),
+             u_top=float(d[rel[:, 1] > 0.999].max(initial=0) / dmax),
+             u_bottom=float(d[rel[:, 1] < 0.001].max(initial=0) / dmax))
+    others = [fields(r) for r in related if r]
+    stress = f.get("stress")
+    if stress is None:
+        stress = next((on_same_points(o, f, "stress") for o in others if "stress" in o), None)
+    if "zeta" in f:
+        z, zs = f["zeta"], m["zeta_star"]
+        i = int(np.argmin(z))
+        m.update(zeta_min=float(z.min()), zeta_max=float(z.max()), zeta_min_at=_rel(base, i),
+                 zeta_min_xy=base[i].tolist(), area_near_star=float(np.mean(z < zs + 0.09)))
+        band = rel.min(1) < 0.05  # within 5 % of the bottom or the left side
+        m["damage_band_ratio"] = float((1 - z[band]).mean() / max((1 - z[~band]).mean(), 1e-300))
+        if stress is not None:
+            m["rank_stress_damage"] = rank_correlation(stress, -z)
+    if stress is not None:
+        i = int(np.argmax(stress))
+        m.update(stress_max=float(stress.max()), stress_max_at=_rel(base, i))
+        band = rel.min(1) < 0.05
+        m["stress_band_ratio"] = float(stress[band].mean() / max(stress[~band].mean(), 1e-300))
+    for o in others:  # a pair of runs on one mesh (Figures 2.4 and 2.5)
+        if "zeta" in o and "zeta" in f:
+            z_other = on_same_points(o, f, "zeta")
+            m["pair_rank_zeta"] = rank_correlation(f["zeta"], z_other)
+            m["pair_max_dzeta"] = float(np.abs(f["zeta"] - z_other).max())
+        if "stress" in o and "stress" in f:
+            m["pair_rank_stress"] = rank_correlation(f["stress"], on_same_points(o, f, "stress"))
+    return m
+
+
+def _between(m, c, key):
+    return m[key] if key in m else c[key]
+
+
+CHECKS = {  # name: (what is tested, predicate(measures, context) -> bool or None)
+    "physical": ("the damage field plotted is within [ζ*, 1]",
+                 lambda m, c: m["zeta_min"] >= m["zeta_star"] - 1e-6 and m["zeta_max"] <= 1 + 1e-6),
+    "localised": ("damage concentrated (less than half of the body within 0.09 of ζ*)",
+                  lambda m, c: m["area_near_star"] < 0.5),
+    "min_zeta_lower_right": ("most damaged point in the lower right",
+                             lambda m, c: quadrant(m["zeta_min_at"]) == "lower right"),
+    "min_zeta_top_or_lower_right": ("most damaged point on the upper boundary or lower right",
+                                    lambda m, c: m["zeta_min_at"][1] > 0.9
+                                    or quadrant(m["zeta_min_at"]) == "lower right"),
+    "min_zeta_left": ("most damaged point near the clamped side (x1 in the left third)",
+                      lambda m, c: m["zeta_min_at"][0] < 1 / 3),
+    "damage_at_top_or_bottom": ("most damaged point on a contact boundary (top or bottom)",
+                                lambda m, c: min(m["zeta_min_at"][1], 1 - m["zeta_min_at"][1]) < 0.05),
+    "contact_bands": ("stress and damage (1 - ζ) higher on average in the contact bands (within "
+                      "5 % of the bottom or the left side) than in the rest of the body",
+                      lambda m, c: m["stress_band_ratio"] > 1 and m["damage_band_ratio"] > 1),
+    "colocated": (f"stress and damage (1 - ζ) rank together (rank correlation ≥ {RANK_AGREE})",
+                  lambda m, c: m["rank_stress_damage"] >= RANK_AGREE),
+    "stress_pattern_same": (f"the stresses have the other run's pattern (rank correlation ≥ "
+                            f"{RANK_SAME})", lambda m, c: m["pair_rank_stress"] >= RANK_SAME),
+    "damage_pattern_differs": (f"the damage pattern differs from the other run's (rank "
+                               f"correlation below {RANK_SAME})",
+                               lambda m, c: m["pair_rank_zeta"] < RANK_SAME),
+    "top_fixed_bottom_moves": ("upper boundary moves < 10 % of the lower one",
+                               lambda m, c: m["u_top"] < 0.1 * max(m["u_bottom"], 1e-30)),
+    "bottom_fixed": ("contact boundary (bottom) moves < 5 % of the largest displacement",
+                     lambda m, c: m["u_bottom"] < 0.05),
+    "readable": ("the drawn (amplified) displacement stays below the body size, as in the "
+                 "thesis's figure", lambda m, c: m["u_max"] * (m["amplification"] or 1) < m["size"]),
+    "no_penetration": ("penetration into the obstacle (rms over the contact boundary, final "
+                       "time) below 1 % of the largest displacement",
+                       lambda m, c: c["penetration_last"] <= 0.01 * m["u_max"]),
+    "stressed": ("stress not zero at the final time", lambda m, c: m["stress_max"] > 0),
+    "displaced": ("the body not back in its initial position at the final time (||u||_L2 above "
+                  "10 % of its largest value)", lambda m, c: c["u_L2_last"] > 0.1 * c["u_L2_max"]),
+    "position_recovers": ("the body returns toward its stress-free position: ||u||_L2 at the "
+                          "final time below half its value at t = 0",
+                          lambda m, c: c["u_L2_last"] < 0.5 * c["u_L2_first"]),
+    "four_hinges": ("a four-hinge mechanism (mechanism hinges of the bridge summary)",
+                    lambda m, c: c["hinges"] == 4),
+    "probe_reaches_star": ("ζ(0, 6) reaches ζ* in finite time",
+                           lambda m, c: c["probe_min"] <= c["zeta_star"] + 1e-3),
+    "minimum_at_edges": ("last profile most damaged at an edge point (x1 = 0 or 6)",
+                         lambda m, c: c["last_min_at_edge"]),
+    "deformation_grows": ("larger deformation at the later time under the same forces",
+                          lambda m, c: c["u_last"] > 1.01 * c["u_first"]),
+    "damage_increases_strain": ("damaged run strains more than the undamaged one (> 1 %)",
+                                lambda m, c: c["strain_damaged"] > 1.01 * c["strain_undamaged"]),
+}
+
+
+def pair_context(fig, npzs) -> dict:
+    """Measures across the files of one figure (two times, or two runs)."""
+    c = {}
+    if len(npzs) == 2 and all(npzs):
+        a, b = (measure(n) for n in npzs)
+        if "damage_increases_strain" in fig.checks:
+            c["strain_undamaged"], c["strain_damaged"] = a["stress_max"], b["stress_max"]
+        if "deformation_grows" in fig.checks:
+            c["u_first"], c["u_last"] = a["u_max"], b["u_max"]
+    return c
+
+
+def run_context(folder) -> dict:
+    """Measures from a run folder: history (u_L2, penetration, the probe), the last damage
+    profile (3.3-ex2), the reading and its departures, the run's final time."""
+    c = {}
+    folder = Path(folder) if folder else None
+    if folder is None:
+        return c
+    try:
+        summary = json.loads((folder / "summary.json").read_text())
+        c["zeta_star"] = float(summary["parameters"]["zeta_star"])
+        c["reading"] = summary.get("reading")
+        with open(folder / "history.csv") as f:
+            rows = list(csv.DictReader(f))
+        col = lambda name: [float(r[name]) for r in rows if r.get(name)]  # noqa: E731
+        if col("u_L2"):
+            u = col("u_L2")
+            c.update(u_L2_first=u[0], u_L2_last=u[-1], u_L2_max=max(u))
+        if col("penetration_rms"):
+            c["penetration_last"] = col("penetration_rms")[-1]
+        if col("zeta_probe"):
+            c["probe_min"] = min(col("zeta_probe"))
+        if rows:
+            c["t_last"] = float(rows[-1]["t"])
+        prof = summary.get("profiles")
+        if prof:
+            x1, last = np.asarray(prof["x1"], float), np.asarray(prof["last_zeta"], float)
+            edge = np.isclose(x1, x1.min()) | np.isclose(x1, x1.max())
+            c["last_min_at_edge"] = bool(last[edge].min() <= last.min() + 1e-9)
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+    return c
+
+
+def departure(text: str) -> str:
+    """A reading's departure from the stated data, short: 'kappa = 0.003 instead of kappa = 1
+    (fitted)'."""
+    import re
+    m = re.match(r"R\d+ \(([^)]*)\):\s*(.*)", text)
+    if not m:
+        return text
+    kind = m.group(1).split("; ", 1)[-1] if "; " in m.group(1) else "not stated in the text"
+    kind = "fitted" if kind.startswith("FITTED") else kind
+    what = re.split(r" \([^()]*\blines? \d|\. |; |: |, the ", m.group(2), maxsplit=1)[0]
+    return f"{what[:120]} ({kind})"
+
+
+def judge(fig, npzs, related=(), context=None) -> tuple:
+    """(verdict, what we get, failed checks) of one field figure; the verdict starts with its
+    class (report_verdicts.CLASSES)."""
+    c = dict(context or {}, **pair_context(fig, npzs))
+    first = next((n for n in npzs if n), None)
+    m = measure(first, related) if first else {}
+    results = []
+    for name in fig.checks:
+        desc, pred = CHECKS[name]
+        try:
+            ok = bool(pred(m, c))
+        except (KeyError, TypeError, IndexError, ValueError):
+            ok = None
+        results.append((name, desc, ok))
+    got = describe(m, c, fig.checks)
+    measured = [r for r in results if r[2] is not None]
+    if not fig.checks:
+        return "not comparable: no check measures the statement", got or "-", []
+    if not measured:
+        return "not comparable: nothing the statement says is measured", got or "no data", []
+    zs = m.get("zeta_star", 0.01)
+    truncated = c.get("T_run") is not None and c.get("T_full") and \
+        c["T_run"] < 0.999 * c["T_full"]
+    stop = (f"the quick run stops at t = {c['T_run']:g} of the thesis's T = {c['T_full']:g}"
+            if truncated else "")
+    if fig.about_damage and "zeta_min" in m and 1 - m["zeta_min"] < NO_DAMAGE:
+        return (f"not visible in this figure: no damage has developed (ζ ≥ {m['zeta_min']:.5g} "
+                f"everywhere){'; ' + stop if truncated else ''}: nothing to locate"), got, []
+    if truncated:
+        return f"not comparable: {stop}", got, []
+    failed = [desc for _, desc, ok in measured if not ok]
+    if failed:
+        return "differs: does not hold: " + "; ".join(failed), got, failed
+    held = "; ".join(desc for _, desc, _ in measured)
+    if "pair_max_dzeta" in m and "damage_pattern_differs" in fig.checks \
+            and m["pair_max_dzeta"] < 0.1 * (1 - zs):
+        return (f"not visible in this figure: the two damage fields differ by at most |Δζ| = "
+                f"{m['pair_max_dzeta']:.2g} on the fixed [{zs:g}, 1] scale (the same colours); "
+                f"the data show: {held}; the panels on each field's own range show the two "
+                f"patterns"), got, []
+    if fig.about_damage and "zeta_min" in m and \
+            m["zeta_max"] - m["zeta_min"] < NARROW_DAMAGE * (1 - zs):
+        return (f"not visible in this figure: on the fixed [{zs:g}, 1] scale the damage (ζ in "
+                f"[{m['zeta_min']:.3g}, {m['zeta_max']:.3g}]) is one colour; the data show: "
+                f"{held}; the added panel on the field's own range shows it"), got, []
+    if c.get("departures"):
+        return ("reproduced under a reading: " + "; ".join(departure(d) for d in c["departures"])
+                ), got, []
+    return "reproduced", got, []
+
+
+def describe(m: dict, c: dict, checks=()) -> str:
+    """What we get, in numbers (the summary's 'what we get' column)."""
+    parts = []
+    if "zeta_min" in m:
+        parts.append(f"ζ in [{m['zeta_min']:.3g}, {m['zeta_max']:.3g}]")
+        if 1 - m["zeta_min"] >= NO_DAMAGE:
+            parts.append(f"most damaged at {quadrant(m['zeta_min_at'])} (x = "
+                         f"{m['zeta_min_xy'][0]:.2g}, {m['zeta_min_xy'][1]:.2g}), "
+                         f"{100 * m['area_near_star']:.0f} % of the nodes within 0.09 of ζ*")
+    if "stress_max_at" in m:
+        parts.append(f"max stress {m['stress_max']:.3g} Pa at {quadrant(m['stress_max_at'])}")
+    if "rank_stress_damage" in m and {"colocated", "contact_bands"} & set(checks):
+        parts.append(f"rank correlation stress / damage {m['rank_stress_damage']:.2f}")
+    if "contact_bands" in checks and "damage_band_ratio" in m:
+        parts.append(f"contact bands against the rest: stress {m.get('stress_band_ratio', 0):.2f}x, "
+                     f"damage {m['damage_band_ratio']:.2f}x")
+    if "pair_rank_zeta" in m:
+        parts.append(f"against Figure 2.4: stress rank correlation {m.get('pair_rank_stress', 0):.2f}, "
+                     f"damage rank correlation {m['pair_rank_zeta']:.2f}, max |Δζ| "
+                     f"{m['pair_max_dzeta']:.2g}")
+    if "u_max" in m and {"top_fixed_bottom_moves", "bottom_fixed", "readable",
+                         "no_penetration"} & set(checks):
+        parts.append(f"max |u| = {m['u_max']:.3g} m on a body of size {m['size']:.3g} m, drawn "
+                     f"x{m['amplification']:g} (top edge {m['u_top']:.2f}, bottom edge "
+                     f"{m['u_bottom']:.2f} of max |u|)")
+    if {"position_recovers", "displaced"} & set(checks) and "u_L2_first" in c:
+        parts.append(f"||u||_L2 {c['u_L2_first']:.3g} m at t = 0, largest {c['u_L2_max']:.3g} m, "
+                     f"{c['u_L2_last']:.3g} m at the final time")
+    if "no_penetration" in checks and "penetration_last" in c:
+        parts.append(f"penetration (rms) {c['penetration_last']:.2g} m at the final time")
+    for key, label in (("hinges", "mechanism hinges"), ("failure_load_kN", "failure load [kN]"),
+                       ("probe_min", "min ζ(0, 6)"), ("u_first", "max |u| first"),
+                       ("u_last", "max |u| later"), ("strain_undamaged", "max strain undamaged"),
+                       ("strain_damaged", "max strain damaged")):
+        if key in c:
+            parts.append(f"{label} = {c[key]:.4g}")
+    if "last_min_at_edge" in c:
+        parts.append(f"last profile most damaged at an edge: {'yes' if c['last_min_at_edge'] else 'no'}")
+    return "; ".join(parts)
