@@ -263,12 +263,13 @@ def locate_entities(msh, dim, marker):
 
 
 def cell_diameters(msh, cells):
-    """Diameters of the given local cells (``cpp.mesh.h`` up to 0.7, ``Mesh.h`` later)."""
-    from dolfinx import cpp
-    cells = np.asarray(cells, dtype=np.int32)
-    if hasattr(cpp.mesh, "h"):
-        return np.asarray(cpp.mesh.h(msh, msh.topology.dim, cells))
-    return np.asarray(msh.h(msh.topology.dim, cells))
+    """Largest vertex distance of the given local cells (NumPy; 0.5.2's ``cpp.mesh.h`` refuses
+    the Python Mesh)."""
+    g = msh.geometry.dofmap
+    arr = g.array.reshape(-1, g.links(0).size) if hasattr(g, "array") else np.asarray(g)
+    xs = msh.geometry.x[arr[np.asarray(cells, dtype=np.int64)]]
+    d = xs[:, :, None, :] - xs[:, None, :, :]
+    return np.sqrt((d ** 2).sum(axis=-1)).max(axis=(1, 2))
 
 
 def meshtags(msh, dim, entities, values):

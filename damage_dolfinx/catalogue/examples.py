@@ -133,6 +133,8 @@ class Example:
         from damage_dolfinx.models.registry import validate
         params = validate(info.id, self.params.replace(**overrides))
         T = self.T if T is None else float(T)
+        if k is None and self.own:  # an own problem's k is its author's choice
+            k = self.k
         k = self.default_k(n, h, T, params) if k is None else float(k)
         time = TimeGrid(k, T)
         k_max = quasistatic_k_max(info.id, params)
