@@ -370,6 +370,10 @@ def auto_amplification(stepper, diameter) -> float:
 
 def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
     """One catalogue figure (PNG) of the current state; returns its file entry."""
+    out = Path(out)
+    if stepper.comm.rank == 0:
+        out.mkdir(parents=True, exist_ok=True)
+    stepper.comm.barrier()
     filename = fig.filename.replace(".png", f"{suffix}.png")
     if fig.kind == "history":  # history.csv is complete and flushed at the end of the run
         if stepper.comm.rank == 0:
