@@ -54,6 +54,7 @@ myst_heading_anchors = 3
 
 autodoc_member_order = "bysource"
 autodoc_typehints = "description"
+autodoc_typehints_description_target = "documented"  # no lists of undocumented parameters
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
 napoleon_google_docstring = True
 napoleon_numpy_docstring = True
@@ -120,7 +121,7 @@ sphinx_gallery_conf = {
 # --- command-line reference ----------------------------------------------------------------
 def _cli_page():
     from damage_dolfinx import cli
-    os.environ["COLUMNS"] = "100"  # argparse wraps at the terminal width: fix it
+    os.environ["COLUMNS"] = "80"  # argparse wraps at the terminal width: the width of the page
     parser = cli._parser()
     subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     lines = ["## `damage-dolfinx`", "", "```text", parser.format_help().rstrip(), "```", ""]
@@ -140,17 +141,20 @@ def _api_page():
     for name in names:
         obj = getattr(damage_dolfinx, name)
         if inspect.ismodule(obj):
-            groups["Modules"].append(f".. automodule:: {obj.__name__}\n   :members:\n")
+            kind, directive = "Modules", f".. automodule:: {obj.__name__}\n   :members:"
         elif inspect.isclass(obj):
-            groups["Classes"].append(f".. autoclass:: damage_dolfinx.{name}\n   :members:\n")
+            kind, directive = "Classes", f".. autoclass:: damage_dolfinx.{name}\n   :members:"
         elif callable(obj):
-            groups["Functions"].append(f".. autofunction:: damage_dolfinx.{name}\n")
+            kind, directive = "Functions", f".. autofunction:: damage_dolfinx.{name}"
         else:
-            groups["Data"].append(f".. autodata:: damage_dolfinx.{name}\n   :annotation:\n")
+            kind, directive = "Data", f".. autodata:: damage_dolfinx.{name}"
+        # a module gets a heading; functions and classes are listed by the page's contents
+        heading = f"### `{obj.__name__}`\n\n" if kind == "Modules" else ""
+        groups[kind].append(f"{heading}```{{eval-rst}}\n{directive}\n```\n")
     lines = []
-    for title, entries in groups.items():
+    for kind, entries in groups.items():
         if entries:
-            lines += [f"## {title}", "", "```{eval-rst}", *entries, "```", ""]
+            lines += [f"## {kind}", "", *entries]
     return "\n".join(lines)
 
 
