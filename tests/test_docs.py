@@ -41,9 +41,11 @@ window.addEventListener("load", () => setTimeout(() => {
 </script>"""
 
 
-def build_site(out):
-    """Build the site into ``out``/html with warnings as errors; returns (seconds, stderr)."""
-    env = dict(ENV, DAMAGE_DOLFINX_DOCS_BUILD=str(out))
+def build_site(out, results=None):
+    """Build the site into ``out``/html with warnings as errors (the report taken from
+    ``results``, default: none); returns (seconds, stderr)."""
+    env = dict(ENV, DAMAGE_DOLFINX_DOCS_BUILD=str(out),
+               DAMAGE_DOLFINX_RESULTS=str(results or out / "no-results"))
     start = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going",
                            "-d", str(out / "doctrees"), str(ROOT / "docs"), str(out / "html")],
@@ -159,3 +161,31 @@ def test_no_machine_paths(site):
         found += [f"{page.relative_to(site)}: {m.group(0)}"
                   for m in re.finditer(r"(?<![\w.])/(?:work|tmp|root|home)/[^\s'`\"<]*", text)]
     assert not found, f"{len(found)} machine paths:\n" + "\n".join(found[:20])
+
+
+def test_report_copied_and_linked(tmp_path):
+    """With a report in the results folder, the site links it, copied with its figures."""
+    if CHROMIUM is None:
+        pytest.skip("chromium not installed (make setup installs it)")
+    results = tmp_path / "results"
+    (results / "figures").mkdir(parents=True)
+    (results / "unused.txt").write_text("not referenced by the report")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(2, 2))
+    ax.plot([0, 1], [0, 1])
+    fig.savefig(results / "figures" / "figure_2_1.png")
+    plt.close(fig)
+    (results / "REPORT.html").write_text(
+        '<html><body><h1 id="top">Report</h1><img src="figures/figure_2_1.png">'
+        '<a href="#top">top</a></body></html>')
+    build_site(tmp_path / "site", results)
+    html = tmp_path / "site" / "html"
+    assert 'href="report/REPORT.html"' in (html / "report.html").read_text()
+    assert (html / "report" / "figures" / "figure_2_1.png").is_file()
+    assert not (html / "report" / "unused.txt").exists()  # only what the report uses
+    page = html / "report" / "REPORT.html"
+    page.write_text(page.read_text().replace("</body>", PROBE + "</body>"))
+    found = probe_page(page)
+    assert found["images"] == 1 and not found["broken"]
