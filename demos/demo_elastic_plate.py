@@ -20,7 +20,7 @@ displacement. This demo runs the model, checks that, and plots how damage starts
 # %%
 # Run the model
 # -------------
-# ``runner.run`` builds the mesh (a 10 x 10 grid on the square :math:`(0, 5)^2` minus the hole
+# :func:`damage_dolfinx.run` builds the mesh (a 10 x 10 grid on the square :math:`(0, 5)^2` minus the hole
 # :math:`[2, 3]^2`), the model of Section 2.1 and its time stepper, runs it to
 # :math:`T = 0.5` with the time step :math:`k = 0.05`, and writes a run folder:
 # ``summary.json``, ``history.csv``, ``fields.xdmf`` and the figures.
@@ -31,10 +31,11 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx import runner
+import damage_dolfinx
 
 out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "elastic_plate"
-summary = runner.run("2.1-ex1", out, n=10, k=0.05, T=0.5, progress=False)
+summary = damage_dolfinx.run("2.1-ex1", out, n=10, k=0.05, T=0.5, overwrite=True,
+                             progress=False)
 comm = MPI.COMM_WORLD
 if comm.rank == 0:
     final = summary["final"]

@@ -19,9 +19,11 @@ import argparse
 import importlib
 import inspect
 import os
+import pprint
 import re
 import shutil
 import sys
+import textwrap
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -58,6 +60,7 @@ autodoc_typehints_description_target = "documented"  # no lists of undocumented 
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
 napoleon_google_docstring = True
 napoleon_numpy_docstring = True
+napoleon_use_ivar = True  # "Attributes:" as fields: a dataclass's fields are not listed twice
 
 html_theme = "furo"
 html_title = f"damage-dolfinx {release}"
@@ -144,14 +147,17 @@ def _api_page():
             kind, directive = "Modules", f".. automodule:: {obj.__name__}\n   :members:"
         elif inspect.isclass(obj):
             kind, directive = "Classes", f".. autoclass:: damage_dolfinx.{name}\n   :members:"
-        elif callable(obj):
+        elif inspect.isroutine(obj):
             kind, directive = "Functions", f".. autofunction:: damage_dolfinx.{name}"
         else:
-            kind, directive = "Data", f".. autodata:: damage_dolfinx.{name}"
+            kind, directive = "Data", f".. autodata:: damage_dolfinx.{name}\n   :no-value:"
+            value = pprint.pformat(obj, width=88, sort_dicts=False)
+            if isinstance(obj, (dict, list, tuple, str, int, float)) and len(value) < 3000:
+                directive += "\n\n   .. code-block:: python\n\n" + textwrap.indent(value, "      ")
         # a module gets a heading; functions and classes are listed by the page's contents
         heading = f"### `{obj.__name__}`\n\n" if kind == "Modules" else ""
         groups[kind].append(f"{heading}```{{eval-rst}}\n{directive}\n```\n")
-    lines = []
+    lines = ["```{eval-rst}", ".. automodule:: damage_dolfinx", "   :no-members:", "```", ""]
     for kind, entries in groups.items():
         if entries:
             lines += [f"## {kind}", "", *entries]
@@ -201,5 +207,30 @@ def _generate(app):
     _write_if_changed(GENERATED / "records.md", _records_page())
 
 
+def _attribute_comment(name, obj):
+    """The ``#:`` comment of ``name`` in the package module that defines ``obj``, if any."""
+    from sphinx.pycode import ModuleAnalyzer
+    for modname, module in sorted(sys.modules.items()):
+        if modname.startswith("damage_dolfinx.") and getattr(module, name, None) is obj:
+            try:
+                docs = ModuleAnalyzer.for_module(modname).find_attr_docs()
+            except Exception:  # noqa: BLE001 - a module without source: no comment
+                continue
+            if ("", name) in docs:
+                return [line for line in docs[("", name)]]
+    return []
+
+
+def _data_docstring(app, what, name, obj, options, lines):
+    """A public data object (a dict, a law instance) has no docstring of its own: autodoc
+    would show its type's (dict's, DamageLaw's). Use the ``#:`` comment where it is defined."""
+    if what != "data":
+        return
+    type_doc = inspect.getdoc(type(obj)) or ""
+    if not lines or (type_doc and type_doc.splitlines()[0].strip() == lines[0].strip()):
+        lines[:] = _attribute_comment(name.rsplit(".", 1)[-1], obj)
+
+
 def setup(app):
     app.connect("builder-inited", _generate)
+    app.connect("autodoc-process-docstring", _data_docstring)
