@@ -17,21 +17,24 @@ export MPLBACKEND := Agg
 
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix \
     python3-ffcx python3-gmsh gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
-    python3-venv python3-setuptools gcc chromium
+    python3-venv python3-setuptools gcc chromium \
+    python3-sphinx python3-myst-parser python3-sphinx-gallery furo libjs-mathjax
 # As root (containers, CI runners) apt-get runs directly; otherwise through sudo. `env` carries
 # DEBIAN_FRONTEND through sudo and works without it (an empty $(SUDO) must not leave a bare flag).
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 APT := $(SUDO) env DEBIAN_FRONTEND=noninteractive apt-get
 
-.PHONY: setup system-deps demo test check-fresh check-paraview test-platforms cross-version bench convergence convergence-quick figures figures-quick \
+.PHONY: setup system-deps demo test docs check-fresh check-paraview test-platforms cross-version bench convergence convergence-quick figures figures-quick \
     report clean
 
 setup: $(VENV)/.installed
 
 # Install the Debian stack only if /usr/bin/python3 cannot already import it.
 system-deps:
-	@if /usr/bin/python3 -c "import dolfinx, petsc4py, mpi4py, ufl, basix, ffcx, gmsh, matplotlib, pytest, scipy" \
-	    2>/dev/null && command -v mpirun >/dev/null && command -v chromium >/dev/null; then \
+	@if /usr/bin/python3 -c "import dolfinx, petsc4py, mpi4py, ufl, basix, ffcx, gmsh, matplotlib, pytest, scipy, \
+	    sphinx, myst_parser, sphinx_gallery, furo" \
+	    2>/dev/null && command -v mpirun >/dev/null && command -v chromium >/dev/null \
+	    && [ -f /usr/share/javascript/mathjax/MathJax.js ]; then \
 	  echo "setup: Debian FEniCSx stack present"; \
 	else \
 	  echo "setup: installing the Debian FEniCSx stack (apt-get)"; \
@@ -53,6 +56,14 @@ demo: setup
 
 test: setup
 	$(PY) -m pytest -q -ra tests $(PYTEST_ARGS)
+
+# The documentation site (Sphinx, furo theme, sphinx-gallery executing demos/*.py) into
+# build/docs/html; warnings are errors. DOCS_BUILD and OUT (where `make report` wrote) can move it.
+DOCS_BUILD ?= build/docs
+docs: setup
+	DAMAGE_DOLFINX_DOCS_BUILD=$(abspath $(DOCS_BUILD)) DAMAGE_DOLFINX_RESULTS=$(abspath $(OUT)) \
+	    $(PY) -m sphinx -b html -W --keep-going -d $(DOCS_BUILD)/doctrees docs $(DOCS_BUILD)/html
+	@echo "documentation in $(DOCS_BUILD)/html/index.html"
 
 bench: setup
 	$(MPIRUN) $(PY) benchmarks/step_timing_2_1.py
@@ -101,4 +112,4 @@ check-paraview: setup
 	$(PY) benchmarks/paraview_check.py $$(ls -d $(OUT)/paraview-runs/*/) --out $(OUT)/paraview-check
 
 clean:
-	rm -rf $(VENV) results .pytest_cache build *.egg-info
+	rm -rf $(VENV) results .pytest_cache build *.egg-info docs/_generated docs/demos

@@ -67,8 +67,9 @@ def _phi_B(e, z, p):
     return phi_B(e, z, p)
 
 
-#: the thesis laws (1.3) and (1.4)
+#: the thesis law of variant A, (1.3)
 THESIS_A = DamageLaw(_phi_A, "thesis-A")
+#: the thesis law of variant B, (1.4), with the tension/compression split of the strain
 THESIS_B = DamageLaw(_phi_B, "thesis-B")
 
 

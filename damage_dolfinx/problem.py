@@ -41,8 +41,8 @@ class Problem:
             viscoplastic, ``"3.1"`` dynamic with normal compliance, ``"3.2"`` dynamic with
             Tresca friction, ``"3.3"`` fully damageable dynamic).
         mesh: a :class:`~damage_dolfinx.geometries.Geometry`, a ``(mesh, facet_tags)`` pair, the
-            path of a gmsh ``.msh`` file, or a function ``(comm, n) -> `` one of these (a mesh
-            family: the only form :func:`~damage_dolfinx.converge` can refine).
+            path of a gmsh ``.msh`` file, or a function ``(comm, n)`` returning one of these (a
+            mesh family: the only form :func:`~damage_dolfinx.converge` can refine).
         T: final time.
         k: time step (None: the largest below 0.8 k_max and T/100 that divides T; for the
             dynamic models k must be given). A k above the scheme's stability limit k_max is
@@ -57,8 +57,9 @@ class Problem:
         params: a :class:`~damage_dolfinx.ModelParameters`, or a dict of changes to the
             model's defaults (:func:`~damage_dolfinx.model_defaults`); unknown names are
             refused, except your own law's data, which go to ``params.extra``.
-        traction, body_force: ``(x, t) -> UFL vector`` (x the spatial coordinate, t a
-            constant holding the time).
+        traction: ``(x, t) -> UFL vector`` (x the spatial coordinate, t a constant holding
+            the time), on the ``traction`` boundary.
+        body_force: ``(x, t) -> UFL vector``, the same for the body force.
         zeta0: initial damage, a number or a function of x (NumPy, shape (gdim, N)) in
             [zeta*, 1].
         damage_law: a :class:`~damage_dolfinx.DamageLaw` (None: the thesis law of

@@ -1,0 +1,236 @@
+"""Sphinx configuration of the damage-dolfinx documentation (``make docs``).
+
+Three pages are generated here at every build, from the code itself, into ``_generated/``
+(not kept in git) and included by their page:
+
+- ``cli.md``: ``damage-dolfinx --help`` and the help of every subcommand, from the argparse
+  parser of ``damage_dolfinx/cli.py``;
+- ``api.md``: one autodoc entry per name in ``damage_dolfinx.__all__`` (functions, classes,
+  modules, data), so a name added to ``__all__`` is documented without touching the docs;
+- ``records.md``: ``benchmarks/README.md`` with its headings one level down;
+- ``report.md``: a link to the thesis reproduction report when ``make report`` has written it
+  (``$DAMAGE_DOLFINX_RESULTS/REPORT.html``, default ``results/``); the report and the files it
+  refers to are copied into the site.
+
+The demos (``demos/*.py``) are executed by sphinx-gallery; each writes its run folder under
+``$DAMAGE_DOLFINX_DEMO_OUT`` (set here to ``<build>/demo-output`` unless already set).
+"""
+import argparse
+import importlib
+import inspect
+import os
+import pprint
+import re
+import shutil
+import sys
+import textwrap
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))
+os.environ.setdefault("MPLBACKEND", "Agg")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import damage_dolfinx  # noqa: E402
+
+project = "damage-dolfinx"
+author = "damage-dolfinx contributors"
+copyright = "damage-dolfinx contributors"
+release = version = damage_dolfinx.__version__
+
+extensions = [
+    "myst_parser",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.napoleon",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "sphinx_gallery.gen_gallery",
+]
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store",
+                    "demos/*.md5", "demos/*.py", "demos/*.ipynb"]
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+myst_heading_anchors = 3
+
+autodoc_member_order = "bysource"
+autodoc_typehints = "description"
+autodoc_typehints_description_target = "documented"  # no lists of undocumented parameters
+autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}
+napoleon_google_docstring = True
+napoleon_numpy_docstring = True
+napoleon_use_ivar = True  # "Attributes:" as fields: a dataclass's fields are not listed twice
+
+html_theme = "furo"
+html_title = f"damage-dolfinx {release}"
+html_static_path = []
+html_show_sourcelink = False
+html_copy_source = False
+html_last_updated_fmt = None
+
+GENERATED = HERE / "_generated"
+GENERATED.mkdir(exist_ok=True)
+
+
+def _write_if_changed(path, text):
+    """Rewrite a generated page only when its text changes (keeps Sphinx's cache valid)."""
+    if not path.exists() or path.read_text() != text:
+        path.write_text(text)
+
+
+# --- MathJax from the Debian package (libjs-mathjax), so the site renders its equations
+# offline; without it Sphinx's default (a CDN) is used.
+MATHJAX = Path("/usr/share/javascript/mathjax")
+MATHJAX_PARTS = ("MathJax.js", "config/TeX-AMS_CHTML.js", "extensions", "jax/input/TeX",
+                 "jax/element", "jax/output/CommonHTML", "fonts/HTML-CSS/TeX/woff")
+if (MATHJAX / "MathJax.js").is_file():
+    _static = GENERATED / "static"
+    for part in MATHJAX_PARTS:
+        src, dst = MATHJAX / part, _static / "mathjax" / part
+        if dst.exists():
+            continue
+        dst.parent.mkdir(parents=True, exist_ok=True)
+        (shutil.copytree if src.is_dir() else shutil.copy2)(src, dst)
+    html_static_path = [str(_static)]
+    mathjax_path = "mathjax/MathJax.js?config=TeX-AMS_CHTML"
+    myst_update_mathjax = False  # MyST's classes would hide its pages' math from MathJax 2
+
+
+# --- sphinx-gallery: the demos -------------------------------------------------------------
+_OUT = Path(os.environ.get("DAMAGE_DOLFINX_DOCS_BUILD", ROOT / "build" / "docs"))
+os.environ.setdefault("DAMAGE_DOLFINX_DEMO_OUT", str(_OUT / "demo-output"))
+
+from sphinx_gallery.sorting import FileNameSortKey  # noqa: E402
+
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "demos"),
+    "gallery_dirs": "demos",
+    "filename_pattern": r"/demo_",      # execute every demo
+    "ignore_pattern": r"(__init__|conftest|test_)",
+    "within_subsection_order": FileNameSortKey,
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "min_reported_time": 0,
+    "capture_repr": (),
+    "image_scrapers": ("matplotlib",),
+    "matplotlib_animations": False,
+    "reset_modules": ("matplotlib",),
+    "line_numbers": False,
+    "reference_url": {"damage_dolfinx": None},  # names in the demos' code link to the API page
+}
+
+
+# --- command-line reference ----------------------------------------------------------------
+def _cli_page():
+    from damage_dolfinx import cli
+    os.environ["COLUMNS"] = "80"  # argparse wraps at the terminal width: the width of the page
+    parser = cli._parser()
+    subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    lines = ["## `damage-dolfinx`", "", "```text", parser.format_help().rstrip(), "```", ""]
+    for name, sub in subs.choices.items():
+        lines += [f"## `damage-dolfinx {name}`", "", "```text", sub.format_help().rstrip(),
+                  "```", ""]
+    return "\n".join(lines)
+
+
+# --- API reference -------------------------------------------------------------------------
+def _api_page():
+    names = list(getattr(damage_dolfinx, "__all__", []))
+    if not names:
+        return ("The package does not declare its public names yet "
+                "(`damage_dolfinx.__all__` is empty).\n")
+    groups = {"Functions": [], "Classes": [], "Modules": [], "Data": []}
+    for name in names:
+        obj = getattr(damage_dolfinx, name)
+        if inspect.ismodule(obj):
+            kind, directive = "Modules", f".. automodule:: {obj.__name__}\n   :members:"
+        elif inspect.isclass(obj):
+            kind, directive = "Classes", f".. autoclass:: damage_dolfinx.{name}\n   :members:"
+        elif inspect.isroutine(obj):
+            kind, directive = "Functions", f".. autofunction:: damage_dolfinx.{name}"
+        else:
+            kind, directive = "Data", f".. autodata:: damage_dolfinx.{name}\n   :no-value:"
+            value = pprint.pformat(obj, width=88, sort_dicts=False)
+            if isinstance(obj, (dict, list, tuple, str, int, float)) and len(value) < 3000:
+                directive += "\n\n   .. code-block:: python\n\n" + textwrap.indent(value, "      ")
+        # a module gets a heading; functions and classes are listed by the page's contents
+        heading = f"### `{obj.__name__}`\n\n" if kind == "Modules" else ""
+        groups[kind].append(f"{heading}```{{eval-rst}}\n{directive}\n```\n")
+    lines = ["```{eval-rst}", ".. automodule:: damage_dolfinx", "   :no-members:", "```", ""]
+    for kind, entries in groups.items():
+        if entries:
+            lines += [f"## {kind}", "", *entries]
+    return "\n".join(lines)
+
+
+# --- the thesis reproduction report --------------------------------------------------------
+def _report_page(app):
+    results = Path(os.environ.get("DAMAGE_DOLFINX_RESULTS", ROOT / "results"))
+    page = results / "REPORT.html"
+    if not page.is_file():
+        return ("The report has not been built in this checkout. Run `make report` (after "
+                "`make figures` and `make convergence`), then `make docs` again: the report "
+                "is then copied into this site and linked here.\n")
+    target = Path(app.outdir) / "report"
+    if target.exists():
+        shutil.rmtree(target)
+    target.mkdir(parents=True)
+    html = page.read_text()
+    shutil.copy2(page, target / "REPORT.html")
+    for ref in set(re.findall(r'(?:src|href)="([^"#:]+)"', html)):
+        src = (results / ref).resolve()
+        if src.is_file() and results.resolve() in src.parents:
+            (target / ref).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, target / ref)
+    return ('The report of this checkout, built by `make report`: '
+            '<a href="report/REPORT.html">open the thesis reproduction report</a>.\n')
+
+
+# --- measured records ----------------------------------------------------------------------
+def _records_page():
+    """benchmarks/README.md as it is, every heading one level down (under the page's title)."""
+    lines, fenced = [], False
+    for line in (ROOT / "benchmarks" / "README.md").read_text().splitlines():
+        if line.lstrip().startswith(("```", "~~~")):
+            fenced = not fenced
+        if not fenced and re.match(r"#{1,5} ", line):
+            line = "#" + line
+        lines.append(line)
+    return "\n".join(lines) + "\n"
+
+
+def _generate(app):
+    _write_if_changed(GENERATED / "cli.md", _cli_page())
+    _write_if_changed(GENERATED / "api.md", _api_page())
+    _write_if_changed(GENERATED / "report.md", _report_page(app))
+    _write_if_changed(GENERATED / "records.md", _records_page())
+
+
+def _attribute_comment(name, obj):
+    """The ``#:`` comment of ``name`` in the package module that defines ``obj``, if any."""
+    from sphinx.pycode import ModuleAnalyzer
+    for modname, module in sorted(sys.modules.items()):
+        if modname.startswith("damage_dolfinx.") and getattr(module, name, None) is obj:
+            try:
+                docs = ModuleAnalyzer.for_module(modname).find_attr_docs()
+            except Exception:  # noqa: BLE001 - a module without source: no comment
+                continue
+            if ("", name) in docs:
+                return [line for line in docs[("", name)]]
+    return []
+
+
+def _data_docstring(app, what, name, obj, options, lines):
+    """A public data object (a dict, a law instance) has no docstring of its own: autodoc
+    would show its type's (dict's, DamageLaw's). Use the ``#:`` comment where it is defined."""
+    if what != "data":
+        return
+    type_doc = inspect.getdoc(type(obj)) or ""
+    if not lines or (type_doc and type_doc.splitlines()[0].strip() == lines[0].strip()):
+        lines[:] = _attribute_comment(name.rsplit(".", 1)[-1], obj)
+
+
+def setup(app):
+    app.connect("builder-inited", _generate)
+    app.connect("autodoc-process-docstring", _data_docstring)
