@@ -1,4 +1,4 @@
-"""Model and time parameters with validation (names as in PROBLEMS.md Section 0).
+"""Model and time parameters with validation (names: docs/models.md, "Common notation").
 
 Invalid input is refused here, before any mesh is built or any form compiled.
 """
@@ -29,7 +29,7 @@ class ModelParameters:
     lam_w: float = 0.0             # threshold
     zeta0: float = 1.0             # initial damage (constant; fields are set by the example)
     L_trunc: float = math.inf      # componentwise stress truncation (2.107)
-    stop_at_zeta_star: bool = True  # G43: stop when min zeta reaches zeta_star
+    stop_at_zeta_star: bool = True  # stop when min zeta reaches zeta_star
     extra: dict = field(default_factory=dict)  # problem-specific data of later sections
 
     def validate(self):
@@ -93,7 +93,8 @@ EXTRA_RULES = {
     "friction_tol": (lambda v: 0 < v < 1, "(relative V-change stopping test) must lie in (0, 1)"),
     "friction_law": (lambda v: v in ("tresca", "coulomb"), "must be 'tresca' or 'coulomb'"),
     "coulomb_normal": (lambda v: v in ("free", "bilateral"), "must be 'free' or 'bilateral'"),
-    "viscoplastic_sign": (lambda v: v in (1.0, -1.0), "(sign of G, G19) must be 1 or -1"),
+    "viscoplastic_sign": (lambda v: v in (1.0, -1.0),
+                          "(sign of the viscoplastic function G) must be 1 or -1"),
     "memory_kernel": (lambda v: v in ("constant", "exponential"),
                       "must be 'constant' or 'exponential'"),
     "memory_rate": (lambda v: v >= 0, "(decay rate of the exponential kernel) must be >= 0"),
@@ -104,16 +105,16 @@ EXTRA_RULES = {
     "history_every": (lambda v: v >= 1 and v == int(v),
                       "(a history.csv row every that many steps) must be a whole number >= 1"),
     "stability_check": (lambda v: v in ("warn", "error", "off"),
-                        "(explicit-term time-step check, PROBLEMS.md 1.8) must be warn, error or off"),
+                        "(explicit-term time-step check) must be warn, error or off"),
     "damage_active": (lambda v: isinstance(v, bool),
                       "(False: damage frozen at zeta_0, Section 3.1 Ex. 3) must be true or false"),
     "error_norm": (lambda v: v in ("velocity", "displacement", "velocity_only"),
-                   "(convergence error of Section 3.1, G27) must be velocity, displacement or "
+                   "(convergence error of Section 3.1) must be velocity, displacement or "
                    "velocity_only"),
     "stress_in_error": (lambda v: v in ("yes", "no"),
                         "(Section 2.4: ||sigma - sigma_hk||_Q in e_hk) must be yes or no"),
     "elastic_term": (lambda v: v in ("explicit", "implicit"),
-                     "(Section 3.3: explicit = thesis scheme, implicit = G33 deviation) must be "
+                     "(Section 3.3: explicit = thesis scheme, implicit = a deviation) must be "
                      "'explicit' or 'implicit'"),
     "initial_damage": (lambda v: v in ("a", "b"),
                        "(Section 3.3 Ex. 2: a = centre [2.5,3.5]^2, b = bottom [2.5,3.5]x[0,1]) "

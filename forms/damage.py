@@ -1,4 +1,4 @@
-"""Discrete damage step shared by all seven schemes (PROBLEMS.md 1.4).
+"""Discrete damage step shared by all seven schemes (docs/models.md, "The damage step").
 
 b(z, xi) = (z, xi) + k kappa (grad z, grad xi),  l(xi) = (zeta_old, xi) + k (phi_old, xi):
 the PDE form (1.5) solves b(zeta_n, .) = l; the obstacle form solves the VI over
@@ -6,7 +6,7 @@ K^h = {zeta_star <= xi <= 1}.
 """
 import ufl
 
-#: quadrature degree of the non-polynomial damage source (G38)
+#: quadrature degree of the non-polynomial damage source (not stated in the thesis)
 SOURCE_DEGREE = 2
 
 

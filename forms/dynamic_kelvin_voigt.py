@@ -5,7 +5,8 @@
 
 A = B / m_visc, p_nu(r) = c_nu r_+. Inertia and viscosity implicit (a constant bilinear form for
 a fixed k), the damaged truncated elastic force (2.106) and the contact force explicit, i.e. a
-linear system with a fixed matrix (the thesis' (3.64) is this equation times k, G28).
+linear system with a fixed matrix (the thesis' (3.64) is this equation times k, up to its
+misprints; docs/models.md, section 3.1).
 """
 import ufl
 
@@ -15,7 +16,8 @@ from damage_dolfinx.numerics.contact import normal_compliance_pressure
 from damage_dolfinx.forms.elastic_damage import load
 from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, viscous_stress
 
-#: quadrature degree of the truncated (Phi_L) and positive-part (contact) terms (G38)
+#: quadrature degree of the truncated (Phi_L) and positive-part (contact) terms (the thesis
+#: states none)
 NONLINEAR_DEGREE = 2
 
 

@@ -4,8 +4,9 @@
         >= L_n(w - v_n) - (eta_*(zeta_{n-1}) Phi_L(B eps(u_{n-1})), eps(w - v_n)),
 
 A = B / m_visc; inertia and viscosity implicit, the damaged truncated elastic force explicit
-(PROBLEMS.md 3.2: eta_*(zeta), not zeta, in the elastic operator of Section 3.2). Written as the
-second-kind VI a(v, w - v) + j(w) - j(v) >= l(w - v) that ``friction.FrictionProblem`` takes.
+(eta_*(zeta), not zeta, in the elastic operator of Section 3.2; docs/models.md, section 3.2).
+Written as the second-kind VI a(v, w - v) + j(w) - j(v) >= l(w - v) that
+``friction.FrictionProblem`` takes.
 """
 import ufl
 
@@ -21,7 +22,8 @@ def elastic_stress(u, zeta, E, nu, L_trunc, zeta_star):
 
 
 def total_stress(v, u, zeta, E, nu, m_visc, L_trunc, zeta_star):
-    """sigma_n = A eps(v_n) + E(eps(u_n), zeta_n) (von Mises output, PROBLEMS.md 1.9)."""
+    """sigma_n = A eps(v_n) + E(eps(u_n), zeta_n) (von Mises output; docs/models.md, "Output
+    conventions")."""
     return viscous_stress(v, E, nu, m_visc) + elastic_stress(u, zeta, E, nu, L_trunc, zeta_star)
 
 

@@ -9,10 +9,10 @@ scales the viscosity (with the NEW zeta_n, (3.159)), the elasticity and the cont
 (both with zeta_{n-1}). On K^h (zeta_star <= zeta <= 1 at the vertices) eta_*(zeta) = zeta,
 so writing eta_* changes nothing in the scheme and keeps the forms meaningful for any input.
 
-The non-thesis option ``elastic_term="implicit"`` (G33) evaluates the elastic and contact forces
-at u_n = u_{n-1} + k v_n instead of u_{n-1}: unconditionally stable, for fast qualitative runs
-only; the step is then nonlinear (semismooth in the contact term) and returned as a residual.
-"""
+The non-thesis option ``elastic_term="implicit"`` (docs/models.md, section 3.3) evaluates the
+elastic and contact forces at u_n = u_{n-1} + k v_n instead of u_{n-1}: unconditionally stable, for
+fast qualitative runs only; the step is then nonlinear (semismooth in the contact term) and
+returned as a residual. """
 import ufl
 
 from damage_dolfinx.numerics.constitutive import B, Phi_L, eps, eta_star
@@ -20,7 +20,8 @@ from damage_dolfinx.numerics.contact import positive_part
 
 from damage_dolfinx.forms.elastic_damage import load
 
-#: quadrature degree of the truncated (Phi_L, eta_*) and positive-part (contact) terms (G38)
+#: quadrature degree of the truncated (Phi_L, eta_*) and positive-part (contact) terms (the
+#: thesis states none)
 NONLINEAR_DEGREE = 2
 
 
@@ -92,17 +93,17 @@ def velocity_rhs_boundary(w, u_old, zeta_old, zeta_star, c_nu, gap, n, f_B, f_N,
 
 def implicit_velocity_residual(v, w, v_old, u_old, zeta_new, zeta_old, rho, k, E, nu, m_visc,
                                L_trunc, zeta_star, c_nu, gap, n, f_B, f_N, dsN, dsC):
-    """F(v; w) of the G33 deviation: (3.159) with u_{n-1} replaced by u_{n-1} + k v_n in the
+    """F(v; w) of the implicit deviation: (3.159) with u_{n-1} replaced by u_{n-1} + k v_n in the
     elastic and contact forces (damage factors still zeta_{n-1}); v is the unknown Function."""
     dx = ufl.dx
     dxq, dsq = _measures(dsC)
     u_new = u_old + k * v
     sigma_visc = damaged_viscous_stress(v, zeta_new, E, nu, m_visc, zeta_star)       # zeta_n A eps(v_n)
-    sigma_el = damaged_elastic_stress(u_new, zeta_old, E, nu, L_trunc, zeta_star)   # G33: at u_n
-    p_c = damaged_contact_pressure(u_new, zeta_old, n, c_nu, gap, zeta_star)        # G33: at u_n
+    sigma_el = damaged_elastic_stress(u_new, zeta_old, E, nu, L_trunc, zeta_star)   # at u_n
+    p_c = damaged_contact_pressure(u_new, zeta_old, n, c_nu, gap, zeta_star)        # at u_n
     F = (rho / k * ufl.inner(v - v_old, w) * dx      # (3.159) (rho delta v_n, w)_H
          + ufl.inner(sigma_visc, eps(w)) * dx         # (3.159) (zeta_n A eps(v_n), eps(w))_Q
-         + ufl.inner(sigma_el, eps(w)) * dxq          # G33: (E(eps(u_n), zeta_{n-1}), eps(w))_Q
-         + p_c * ufl.dot(w, n) * dsq)                 # G33: j(zeta_{n-1}, u_n, w)
+         + ufl.inner(sigma_el, eps(w)) * dxq          # (E(eps(u_n), zeta_{n-1}), eps(w))_Q
+         + p_c * ufl.dot(w, n) * dsq)                 # j(zeta_{n-1}, u_n, w)
     L = load(w, f_B, f_N, dsN)                        # (3.159) <f_n, w>
     return F if L is None else F - L

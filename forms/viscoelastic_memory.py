@@ -2,8 +2,8 @@
 
 Displacement step (2.137), with the memory M_n of (2.136) known:
     (B eps(u_n), eps(w)) + (M_n, eps(w)) + int_{Gamma_C} p_nu(u_n.nu - gap) w.nu ds = L_n(w).
-The instantaneous part B is undamaged and untruncated [G16]; M_n is built from
-g(eps, zeta) = zeta Phi_L(B eps) (memory.py).
+The instantaneous part B is undamaged and untruncated (docs/models.md, section 2.3); M_n is built
+from g(eps, zeta) = zeta Phi_L(B eps) (memory.py).
 """
 import ufl
 

@@ -17,7 +17,8 @@ from damage_dolfinx.forms.elastic_damage import load
 
 
 def viscoplastic_rate(sigma, zeta, L_trunc, sign=1.0):
-    """G(sigma, eps(u), zeta) = sign (1 - zeta) Phi_L(sigma) (thesis: sign = +1, G19)."""
+    """G(sigma, eps(u), zeta) = sign (1 - zeta) Phi_L(sigma) (thesis: sign = +1; docs/models.md,
+    section 2.4)."""
     return sign * (1.0 - zeta) * Phi_L(sigma, L_trunc)
 
 

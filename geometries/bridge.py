@@ -1,8 +1,8 @@
 """Masonry arch bridge (Section 2.1 Example 3, thesis Figure 2.6 without the interfaces), gmsh.
 
-The ring is a circular arch of clear ``span`` and ``rise`` (intrados) and radial ``thickness``;
-the default is PROBLEMS.md G3: a semicircular ring with centre-line radius 15/pi (centre line
-15.0 m long), thickness 0.70 m, meshed as an n_r x n_theta mapped grid with n_r =
+The ring is a circular arch of clear ``span`` and ``rise`` (intrados) and radial ``thickness``; the
+default (docs/models.md, section 2.1-collapse) is a semicircular ring with centre-line radius 15/pi
+(centre line 15.0 m long), thickness 0.70 m, meshed as an n_r x n_theta mapped grid with n_r =
 round(thickness/h), n_theta = round(centre-line length/h), every quadrilateral cut into two
 triangles by a fixed diagonal (``structured=True``). At h = 0.05 this is n_r = 14, n_theta = 300:
 8400 triangles and 4515 nodes, the counts the thesis states. ``structured=False`` gives an
@@ -36,7 +36,7 @@ FREE = 4
 #: cell tags
 RING, FILL, ABUTMENT = 1, 2, 3
 
-#: G3 defaults: centre-line radius 15/pi, thickness 0.70 -> intrados radius 4.4246 m
+#: defaults: centre-line radius 15/pi, thickness 0.70 -> intrados radius 4.4246 m
 THICKNESS = 0.70
 RADIUS_CENTRE = 15.0 / math.pi
 SPAN = 2.0 * (RADIUS_CENTRE - THICKNESS / 2.0)
@@ -109,7 +109,7 @@ def arch_bridge(comm, h: float = 0.05, span: float = SPAN, rise: float = RISE,
                 load_half_width: float = 0.05, diagonal: str = "Right", fill: bool = False,
                 cover: float = 0.3, abutments: bool = False,
                 abutment_height: float = 1.0) -> ArchGeometry:
-    """Mesh of the arch ring (G3 defaults); see the module docstring for tags and options."""
+    """Mesh of the arch ring (the defaults); see the module docstring for tags and options."""
     dims = arch_dimensions(span, rise, thickness)
     if not h > 0 or not 0 < load_fraction < 1 or not load_half_width > 0:
         raise InputError(f"need h > 0, 0 < load_fraction < 1, load_half_width > 0; got h = {h}, "

@@ -1,7 +1,7 @@
 """Disc |x| < R minus the diamond |x_1| + |x_2| <= a (Section 2.1 Example 2), gmsh.
 
-Gamma_D = diamond boundary (clamped), Gamma_N = circle [G2]. Mesh size h, refined to h_corner
-near the four diamond corners. The model is meshed on rank 0 and distributed.
+Gamma_D = diamond boundary (clamped), Gamma_N = circle (docs/models.md, section 2.1). Mesh size h,
+refined to h_corner near the four diamond corners. The model is meshed on rank 0 and distributed.
 """
 import gmsh
 

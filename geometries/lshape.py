@@ -1,4 +1,4 @@
-"""Inverted L ("Gamma" shape) of Section 3.1 Example 3 (G26), gmsh.
+"""Inverted L ("Gamma" shape) of Section 3.1 Example 3 (docs/models.md, section 3.1), gmsh.
 
 Omega = (0,2)^2 minus [1,2]x[0,1): a column (0,1)x(0,1) under a full-width top (0,2)x(1,2).
 Facet tags: GAMMA_D = [0,1]x{0} (clamped foot), GAMMA_C = [1,2]x{1} (underside of the overhang,

@@ -1,5 +1,5 @@
 """Structured rectangle (x0, x1) x (y0, y1) with n_x x n_y squares cut along one diagonal
-('right', G10), boundary parts tagged by markers on the facet vertices.
+('right': nested under refinement), boundary parts tagged by markers on the facet vertices.
 
 Used by the unit-square and beam examples of Sections 2.2-3.3; meshes with n and 2n are nested.
 """

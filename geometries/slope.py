@@ -1,4 +1,5 @@
-"""Block on a sloping plane held by a downslope obstacle (thesis 3.2 Example 3, Figure 3.13; G30).
+"""Block on a sloping plane held by a downslope obstacle (thesis 3.2 Example 3, Figure 3.13;
+docs/models.md, section 3.2).
 
 The thesis gives no dimensions. We take Omega = (0, L) x (0, H) (default 2 x 1) in axes aligned
 with the slope: x_1 runs up the slope, x_2 along its outward normal. The body rests on the plane
@@ -24,7 +25,7 @@ SLOPE_ANGLE = math.pi / 4
 
 
 def slope_block(comm, n: int, length: float = 2.0, height: float = 1.0) -> Geometry:
-    """The block with ``n`` cells per unit length (G30: n = 20 gives the 40 x 20 mesh)."""
+    """The block with ``n`` cells per unit length (n = 20 gives the 40 x 20 mesh)."""
     nx, ny = int(round(n * length)), int(round(n * height))
     contact = lambda x: side(1, 0.0)(x) | side(0, 0.0)(x)  # noqa: E731  plane and obstacle
     geometry = rectangle(comm, (0.0, 0.0), (length, height), nx, ny, {GAMMA_C: contact})

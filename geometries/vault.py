@@ -1,5 +1,5 @@
-"""Masonry barrel vault (issue 17): the thesis arch ring (Section 2.1 Example 3, PROBLEMS.md G3)
-extruded along z by a width W, gmsh, tetrahedra.
+"""Masonry barrel vault (beyond the thesis): the thesis arch ring (Section 2.1 Example 3;
+docs/models.md, section 2.1-collapse) extruded along z by a width W, gmsh, tetrahedra.
 
 The 2-D ring of ``geometries/bridge.py`` (structured n_r x n_theta grid, one fixed diagonal per
 quadrilateral; defaults: semicircle, centre-line radius 15/pi, thickness 0.70 m) is extruded by

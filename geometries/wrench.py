@@ -1,17 +1,17 @@
 """Ring (box-end) wrench on a hexagonal screw (Section 3.3 Example 3, thesis Figure 3.19), gmsh.
 
-G35 default, built in a local frame and then rotated: head = disc of radius ``head_radius``
-(1.2) at the origin with a regular hexagonal hole of across-flats ``across_flats`` (1.0; the
-screw occupies the hole); handle = rectangle x in [``handle_start``, ``handle_end``] = [1, 10],
-|y| <= ``handle_width``/2 = 0.4; loaded part = handle top face for x in [``load_start``,
-``handle_end``] = [9, 10]; the body is rotated by ``rotation_deg`` (-45 degrees) about the
-origin, so that the loaded face's outward normal is (1, 1)/sqrt(2) and the traction
+Our default (docs/models.md, section 3.3), built in a local frame and then rotated: head = disc of
+radius ``head_radius`` (1.2) at the origin with a regular hexagonal hole of across-flats
+``across_flats`` (1.0; the screw occupies the hole); handle = rectangle x in [``handle_start``,
+``handle_end``] = [1, 10], |y| <= ``handle_width``/2 = 0.4; loaded part = handle top face for x in
+[``load_start``, ``handle_end``] = [9, 10]; the body is rotated by ``rotation_deg`` (-45 degrees)
+about the origin, so that the loaded face's outward normal is (1, 1)/sqrt(2) and the traction
 (-1e5, -1e5) is a pure pressure. The hexagon has one flat facing the handle (flat normals at
 ``hex_angle_deg`` + 60 j degrees in the local frame, default 0).
 
 Facet tags: GAMMA_C = the six hexagon faces (contact with the rigid screw behind them; the
 body's outward normal there points into the hole, so u.nu > 0 is interpenetration), GAMMA_N =
-the loaded face, FREE = every other exterior face (traction free). Gamma_D is empty (G35, G42).
+the loaded face, FREE = every other exterior face (traction free). Gamma_D is empty.
 Element size ``h`` (0.15), ``h_contact`` (0.05) on the hexagon, growing to h over a distance
 ``transition`` (0.5). The model is meshed on rank 0 and distributed.
 """
@@ -53,7 +53,7 @@ def wrench(comm, h: float = 0.15, h_contact: float = 0.05, head_radius: float = 
            across_flats: float = 1.0, handle_start: float = 1.0, handle_end: float = 10.0,
            handle_width: float = 0.8, load_start: float = 9.0, rotation_deg: float = -45.0,
            hex_angle_deg: float = 0.0, transition: float = 0.5) -> Geometry:
-    """The G35 wrench as a :class:`Geometry` (facet tags GAMMA_C, GAMMA_N, FREE)."""
+    """The wrench as a :class:`Geometry` (facet tags GAMMA_C, GAMMA_N, FREE)."""
     _check(head_radius, across_flats, handle_start, handle_end, handle_width, load_start)
     if not (h > 0 and h_contact > 0):
         raise InputError(f"mesh sizes must be positive, got h = {h}, h_contact = {h_contact}")

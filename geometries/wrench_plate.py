@@ -1,5 +1,5 @@
 """The ring wrench of Section 3.3 Example 3 (thesis Figure 3.19) as a plate with thickness: the
-2-D outline of ``wrench.py`` (G35: head disc R = 1.2 with a hexagonal hole across flats 1.0,
+2-D outline of ``wrench.py`` (head disc R = 1.2 with a hexagonal hole across flats 1.0,
 handle [1, 10] x [-0.4, 0.4], rotated by -45 degrees) extruded along z by ``thickness`` (issue 17).
 
 Thickness 0.4 by default: half the handle width, about the proportion of a real box-end wrench
@@ -10,7 +10,7 @@ Facet tags, the extrusions of the 2-D parts: GAMMA_C = the six hexagon faces (th
 hole, in contact with the rigid screw; outward normal pointing into the hole), GAMMA_N = the
 loaded face (the extruded top of the handle for x in [9, 10] in the local frame, outward normal
 (1, 1, 0)/sqrt(2)), FREE = everything else (the outer sides and the two plate faces z = 0 and
-z = thickness), traction-free. Gamma_D is empty (G35, G42). Element size ``h`` (0.2),
+z = thickness), traction-free. Gamma_D is empty. Element size ``h`` (0.2),
 ``h_contact`` (0.1) on the hexagon faces, growing to h over ``transition`` (0.5). Meshed on
 rank 0 (gmsh, tetrahedra) and distributed.
 """
@@ -31,7 +31,7 @@ def wrench_plate(comm, h: float = 0.2, h_contact: float = 0.1, thickness: float 
                  handle_end: float = 10.0, handle_width: float = 0.8, load_start: float = 9.0,
                  rotation_deg: float = -45.0, hex_angle_deg: float = 0.0,
                  transition: float = 0.5) -> Geometry:
-    """The G35 wrench extruded to a plate, as a :class:`Geometry` (facet tags GAMMA_C, GAMMA_N,
+    """The wrench extruded to a plate, as a :class:`Geometry` (facet tags GAMMA_C, GAMMA_N,
     FREE)."""
     _check(head_radius, across_flats, handle_start, handle_end, handle_width, load_start)
     if not (h > 0 and h_contact > 0 and thickness > 0):

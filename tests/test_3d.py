@@ -110,7 +110,7 @@ def test_von_mises_3x3(cube):
         d = s - np.trace(s) / 3 * np.eye(3)
         got = evaluate(cube, C.von_mises(const(cube, s)))[0]
         assert got == pytest.approx(np.sqrt(1.5 * np.sum(d * d)), rel=1e-13)
-    # plane stress (s_i3 = 0): the 3-D value equals the 2-D formula of PROBLEMS.md 1.9
+    # plane stress (s_i3 = 0): the 3-D value equals the 2-D plane-stress formula
     s = np.zeros((3, 3))
     s[:2, :2] = sym3(100.0)[:2, :2]
     got = evaluate(cube, C.von_mises(const(cube, s)))[0]

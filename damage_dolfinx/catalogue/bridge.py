@@ -3,11 +3,12 @@
 Data from the thesis: E = 5 GPa, nu = 0.49, density 2200 kg/m^3, k = 0.001 s, kappa = 1e-2,
 zeta_star = 0.01, lam_D = 2e-3, lam_u = 5e9, lam_w = 7e-4; mesh of 8400 P1 triangles and 4515
 nodes. Everything else (geometry, supports, load history, q_star, the meaning of the single
-lam_u) is PROBLEMS.md G3, listed in ``assumptions``.
+lam_u) is our default, listed in ``assumptions`` (docs/models.md, section 2.1-collapse).
 
 Readings (issue 16): ``literal`` keeps the linear damage step (2.20), whose zeta leaves
 [zeta_star, 1]; ``evidence`` (the default) solves it as the obstacle problem over [zeta_star, 1]
-(R1 in EVIDENCE). ``--set damage_bound=none|obstacle|clamp`` selects the step directly.
+(the first departure of EVIDENCE). ``--set damage_bound=none|obstacle|clamp`` selects the step
+directly.
 """
 from __future__ import annotations
 
@@ -19,11 +20,11 @@ from damage_dolfinx import ModelParameters
 #: CALIBRATED (the only calibrated parameter): dP/dt of the quarter-span load [kN/s]. With the
 #: thesis data, self weight alone collapses the ring at t = 0.036 s (h = 0.05, k = 0.001, damage
 #: kept in [zeta_star, 1]), so the failure load is load_rate x (failure time) and grows with the
-#: rate: G3's 1000 kN/s gives 30 kN, the thesis's load increment of 0.02 kN per step (line 1127,
-#: stated for the contact model) gives 0.72 kN. 4500 kN/s (4.5 kN per step) is the smallest
-#: multiple of 250 kN/s whose failure load is >= the thesis's 90 kN: 94.5 kN (step 21); 4250 ->
-#: 89.25, 4000 -> 84, 5500 -> 104.5 kN (recalibrated with the bounded damage step, issue 16:
-#: same rate). It holds for the thesis's k = 0.001 only (k = 0.0005 -> 83.25 kN, 0.00025 ->
+#: rate: the model's default 1000 kN/s gives 30 kN, the thesis's load increment of 0.02 kN per step
+#: (line 1127, stated for the contact model) gives 0.72 kN. 4500 kN/s (4.5 kN per step) is the
+#: smallest multiple of 250 kN/s whose failure load is >= the thesis's 90 kN: 94.5 kN (step 21);
+#: 4250 -> 89.25, 4000 -> 84, 5500 -> 104.5 kN (recalibrated with the bounded damage step, issue
+#: 16: same rate). It holds for the thesis's k = 0.001 only (k = 0.0005 -> 83.25 kN, 0.00025 ->
 #: 79.9 kN); the mesh matters less (h = 0.1 ... 0.025: 94.5, 94.5, 94.5, 90, 90 kN).
 #: benchmarks/bridge_sensitivity.py --calibrate reproduces it.
 LOAD_RATE = 4500.0

@@ -1,12 +1,13 @@
 """Catalogue of the thesis examples by id (``2.1-ex1`` ...): data, geometry, scheme, defaults.
 
-Every value the thesis leaves open is an explicit assumption, listed with its PROBLEMS.md gap
-number in the example's ``assumptions`` and copied into each run's summary.json.
+Every value the thesis leaves open is an explicit assumption, listed in the example's
+``assumptions`` and copied into each run's summary.json; docs/models.md gives the reasons, model
+by model.
 
 Readings (``--reading literal|evidence``, issue 16): ``literal`` is exactly the stated thesis
 data (the catalogue entry itself); ``evidence`` replaces some of it by the values that reproduce
 the thesis results with the fewest departures from the text (:class:`Reading`, each departure an
-assumption R<n> with its thesis lines and the measured evidence). An example without an evidence
+assumption with its thesis lines and the measured evidence). An example without an evidence
 reading has evidence = literal. ``Example.default_reading`` says which one runs by default.
 """
 from __future__ import annotations
@@ -27,7 +28,7 @@ class Figure:
     filename: str
     title: str
     fields: tuple = ("von_mises", "zeta")
-    amplification: Optional[float] = None  # None: largest displacement = 10% of diameter (G40)
+    amplification: Optional[float] = None  # None: largest displacement = 10% of diameter
     kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh),
     #                                        "history" (fields = ((column, label), ...) of history.csv)
     #                                        or "profiles" (summary "profiles" + zeta_probe, 3.3-ex2)

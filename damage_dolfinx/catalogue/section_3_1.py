@@ -12,7 +12,8 @@ from damage_dolfinx import ModelParameters
 
 def _params(E, rho, lam_D, c_nu):
     """Data common to the three examples (thesis 3.1.3): nu = 0.3, kappa = 1, lam_u = 1e3,
-    lam_w = 0, zeta_star = 0.01, q_star = 1 (G22), A = B/10 (G24), L_trunc = 1000."""
+    lam_w = 0, zeta_star = 0.01, q_star = 1, A = B/10, L_trunc = 1000 (docs/models.md, section
+    3.1)."""
     return ModelParameters(
         E=E, nu=0.3, kappa=1.0, zeta_star=0.01, q_star=1.0, variant="A", lam_D=lam_D,
         lam_u=1e3, lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False,
@@ -21,15 +22,17 @@ def _params(E, rho, lam_D, c_nu):
 
 
 def layout_example1():
-    """G23: boundary parts of Ex. 1 (thesis Figure 3.1 missing): clamped at x_1 = 0 and 6, loaded
-    top, contact below (the 3.3 Ex. 1 layout); {tag: marker}, change here to try other readings."""
+    """Boundary parts of Ex. 1 (thesis Figure 3.1 missing; docs/models.md, section 3.1): clamped
+    at x_1 = 0 and 6, loaded top, contact below (the 3.3 Ex. 1 layout); {tag: marker}, change
+    here to try other readings."""
     from damage_dolfinx.geometries.rectangle import side
     return {GAMMA_D: lambda x: side(0, 0.0)(x) | side(0, 6.0)(x), GAMMA_N: side(1, 6.0),
             GAMMA_C: side(1, 0.0)}
 
 
 def zeta0_example2(x):
-    """G25: 0.1 on (1.3, 1.7) x (0, 1), rising linearly to 1 at x_1 = 0 and x_1 = 3."""
+    """Initial damage of Ex. 2 (docs/models.md, section 3.1): 0.1 on (1.3, 1.7) x (0, 1), rising
+    linearly to 1 at x_1 = 0 and x_1 = 3."""
     return 0.1 + 0.9 * np.minimum(1.0, np.maximum(0.0, np.abs(x[0] - 1.5) - 0.2) / 1.3)
 
 

@@ -10,8 +10,8 @@ from damage_dolfinx.catalogue.examples import Example, Figure
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx import ModelParameters
 
-#: G33/1.8: default time steps of Examples 2-3, 0.8 k_max or below and dividing T, from
-#: stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)
+#: default time steps of Examples 2-3 (docs/models.md, section 3.3), 0.8 k_max or below and
+#: dividing T, from stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)
 K_EX2 = 6.25e-5
 #: Example 3: 0.8 k_max (k_max = 1.3662e-5 at h = 0.15) rounded down to a divisor of T = 6.5,
 #: 594 703 steps: the k of benchmarks/wrench_3_3.py and of its committed reference (issue 18:

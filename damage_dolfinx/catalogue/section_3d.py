@@ -1,9 +1,8 @@
 """3-D examples beyond the thesis (issue 17): the thesis models on 3-D meshes, same data.
 
-The thesis is 2-D plane stress (PROBLEMS.md Section 0); these entries keep each example's data
-and change only the body to a 3-D one, the elasticity to isotropic 3-D Hooke (whose plane-stress
-reduction is B (2.36)) and the strain of the damage source to the full 3x3 strain.
-"""
+The thesis is 2-D plane stress (docs/models.md, "Common notation"); these entries keep each
+example's data and change only the body to a 3-D one, the elasticity to isotropic 3-D Hooke (whose
+plane-stress reduction is B (2.36)) and the strain of the damage source to the full 3x3 strain. """
 import dataclasses
 import math
 

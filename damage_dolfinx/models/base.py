@@ -104,16 +104,16 @@ class TimeStepper:
         return self.data.time.num_steps
 
     def stop_reason(self) -> Optional[str]:
-        """Why the run must stop early (G43), or None."""
+        """Why the run must stop early (``stop_at_zeta_star``), or None."""
         if self.params.stop_at_zeta_star and self.zeta_min() <= self.params.zeta_star:
             return "zeta_star_reached"
         return None
 
     # -- helpers for subclasses
     def obstacle_damage_step(self, prefix="damage_"):
-        """The damage inclusion step of 2.2, 2.4 and 3.1-3.3 (PROBLEMS.md 1.4): zeta_n in K^h from
-        zeta_{n-1} and the explicit source phi(eps(u_{n-1}), zeta_{n-1}), SNES vinewtonrsls.
-        Needs ``self.u_old``, ``self.zeta`` and ``self.zeta_old``."""
+        """The damage inclusion step of 2.2, 2.4 and 3.1-3.3 (docs/models.md, "The damage step"):
+        zeta_n in K^h from zeta_{n-1} and the explicit source phi(eps(u_{n-1}), zeta_{n-1}), SNES
+        vinewtonrsls. Needs ``self.u_old``, ``self.zeta`` and ``self.zeta_old``."""
         from damage_dolfinx.numerics.damage import DamageStep
         p, msh = self.params, self.mesh
         phi_old = self.damage_source(eps(self.u_old), self.zeta_old)

@@ -1,10 +1,10 @@
 """Section 2.1 Example 3: collapse of a masonry arch ring (scheme (2.20)-(2.21) of
 :class:`ElasticDamage`, plus the load history, the failure criterion and the hinges).
 
-Loads (PROBLEMS.md G3): self weight f_B = (0, -rho g) from t = 0 and a vertical load
-P(t) = load_rate * t [kN per metre of out-of-plane thickness] at quarter span, applied as the
-uniform traction f_N = (0, -P(t)/|Gamma_N|) on the load patch Gamma_N (so that its resultant is
-exactly P whatever the mesh).
+Loads (our defaults, docs/models.md, section 2.1-collapse): self weight f_B = (0, -rho g) from t =
+0 and a vertical load P(t) = load_rate * t [kN per metre of out-of-plane thickness] at quarter
+span, applied as the uniform traction f_N = (0, -P(t)/|Gamma_N|) on the load patch Gamma_N (so that
+its resultant is exactly P whatever the mesh).
 
 Failure (thesis, Section 2.1 Example 3): "collapse occurs at the loading step for which a whole
 cross-section of the bridge reaches the lower bound for the damage zeta_*". A cross-section is a
@@ -78,7 +78,7 @@ BRIDGE_DEFAULTS = {
     "rho": 2200.0,           # density [kg/m^3]
     "gravity": 9.81,         # [m/s^2]; self weight f_B = (0, -rho*gravity); 0 switches it off
     "load_rate": 1000.0,     # dP/dt [kN/s] of the quarter-span load (per metre of thickness);
-                             # G3 proposal; catalogue example 2.1-ex3 uses the calibrated 4500
+                             # our default; catalogue example 2.1-ex3 uses the calibrated 4500
     "hinge_damage": 0.3,     # a hinge is a peak of the section damage D_j of at least this height
     "hinge_prominence": 0.2,  # ... standing out by at least this much (scipy find_peaks)
     "hinge_separation": 0.0,  # merge peaks closer than this [m]; 0 = one ring thickness
@@ -192,7 +192,7 @@ class BridgeDamage(ElasticDamage):
         elif bound == "clamp":
             self.damage = _ClampedStep(self.damage, p.zeta_star)
 
-    # -- loads (G3)
+    # -- loads (docs/models.md, section 2.1-collapse)
     def loads(self):
         """f_B = (0, -rho g[, 0]), f_N = (0, -1000 P(t)/L_N[, 0]) N/m^2 with P(t) = load_rate t
         kN (per metre of width) and L_N the patch length (in 3-D the strip's area / width)."""

@@ -19,9 +19,9 @@ rigid-body near-nullspace (AMG set up once, CG started from v_{n-1}) instead.
 Damage prefix ``damage_``. Parameters in ``extra``: rho, m_visc, c_nu, gap,
 ``damage_active`` (False: zeta frozen at zeta_0 and step (1) skipped, Example 3's undamaged run)
 ``stability_check`` (warn | error | off: k against the limit of the explicit elastic and
-contact forces, stability.py, PROBLEMS.md 1.8) and ``error_norm`` (velocity: convergence errors
-in the norm of Cor. 3.1, ||v||_L2 + ||zeta||_L2 (G27); displacement: ||eps(u)||_L2 +
-||zeta||_L2).
+contact forces, stability.py; docs/models.md, "Stability of the explicit terms") and
+``error_norm`` (velocity: convergence errors in the norm of Cor. 3.1, ||v||_L2 + ||zeta||_L2
+(docs/models.md, section 3.1); displacement: ||eps(u)||_L2 + ||zeta||_L2).
 """
 from __future__ import annotations
 
@@ -66,7 +66,8 @@ class DynamicKelvinVoigt(TimeStepper):
         self.rho, self.m_visc = float(x["rho"]), float(x["m_visc"])
         self.c_nu, self.gap = float(x["c_nu"]), float(x.get("gap", 0.0))
         self.damage_active = bool(x.get("damage_active", True))
-        # G27: ||v||_H + ||zeta||_Y (Cor. 3.1); displacement: ||u||_V + ||zeta||_Y;
+        # ||v||_H + ||zeta||_Y (Cor. 3.1; the thesis does not state its norm);
+        # displacement: ||u||_V + ||zeta||_Y;
         # velocity_only: ||v||_H (issue 16, the reading that reproduces Table 3.1's magnitude)
         self.error_components = {
             "velocity": [("v", self.v, "L2"), ("zeta", self.zeta, "L2")],
@@ -98,7 +99,8 @@ class DynamicKelvinVoigt(TimeStepper):
         scalable.prepare_mech(self.mech, V)  # 3-D: near-nullspace, warm start; 2-D: nothing
         self.stability = self._stability_check(V, x, ds(GAMMA_C))
 
-        # output: von Mises of the total stress and of the strain (PROBLEMS.md 1.9), DG0
+        # output: von Mises of the total stress and of the strain, DG0 (docs/models.md, "Output
+        # conventions")
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
         self.von_mises_strain = fem.Function(Q, name="von_mises_strain")
@@ -130,7 +132,7 @@ class DynamicKelvinVoigt(TimeStepper):
         compat.interpolate(self.von_mises, self._vm_expr)
         compat.interpolate(self.von_mises_strain, self._vm_strain_expr)
 
-    # -- stability of the explicit elastic and contact forces (PROBLEMS.md 1.8)
+    # -- stability of the explicit elastic and contact forces (docs/models.md, section 3.1)
     def _stability_check(self, V, x, dsC) -> dict:
         """k_max of the scheme (undamaged, Gamma_C fully in contact: conservative), compared with
         k according to ``stability_check``; {} when off."""

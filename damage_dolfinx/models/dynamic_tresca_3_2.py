@@ -111,11 +111,11 @@ class DynamicTresca(TimeStepper):
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
 
-    # -- stability of the explicit elastic force (PROBLEMS.md 1.8)
+    # -- stability of the explicit elastic force (docs/models.md, section 3.2)
     def _stability_check(self, V, x):
         """k_max of the explicit elastic term (stability.py), checked against k according to
         ``stability_check`` (warn | error | off); None when off. m_visc = 100 gives
-        k_max just above 2/m_visc = 0.02 (PROBLEMS.md 1.8)."""
+        k_max just above 2/m_visc = 0.02 (docs/models.md, "Stability of the explicit terms")."""
         action = x.get("stability_check", "warn")
         if action == "off":
             return None

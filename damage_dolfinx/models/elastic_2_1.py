@@ -12,7 +12,7 @@ parallel: solvers.lagged_direct), rebuilt only when CG needs more than
 MECH_REFACTOR_ITS iterations (``-mech_ksp_type preonly`` gives a fresh factorisation per step).
 The damage field that factorisation was built from is part of the checkpoint, so that a restart
 rebuilds the same preconditioner and resumes exactly. The run stops when min zeta_n <= zeta_star
-(G43, flag).
+(flag ``stop_at_zeta_star``, docs/models.md, section 2.1).
 Solver prefixes: ``damage_`` (damage PDE) and ``mech_`` (elasticity).
 """
 from __future__ import annotations
@@ -78,7 +78,7 @@ class ElasticDamage(TimeStepper):
         self.zeta_pc = fem.Function(Z, name="zeta_pc")
         self._pc_due = np.ones(1)
 
-        # output: von Mises of the model stress, DG0 (PROBLEMS.md 1.9)
+        # output: von Mises of the model stress, DG0 (docs/models.md, "Output conventions")
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
         self._vm_expr = compat.expression(

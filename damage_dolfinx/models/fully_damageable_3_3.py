@@ -16,12 +16,12 @@ changes every step; it is re-assembled into the same PETSc Mat and solved by CG 
 ``mech_``; the mass rho/k M dominates when m_visc is large, Examples 2-3). V = {v = 0 on
 Gamma_D} (Gamma_D may be empty: the mass keeps (2) definite). u_0 = v_0 = 0.
 
-Parameters in ``extra``: rho, m_visc, c_nu, gap, ``damage_active`` (False: zeta frozen at
-zeta_0), ``stability_check`` (warn | error | off; k against the limit of the explicit elastic
-and contact forces, stability.py, PROBLEMS.md 1.8), ``elastic_term`` = ``explicit`` (the thesis)
-or ``implicit`` (G33 deviation, NOT the thesis scheme: elastic and contact forces at
-u_{n-1} + k v_n, a semismooth Newton solve per step, prefix ``mech_``), ``initial_damage``
-(a key of ``builders["zeta0"]``, Example 2's cases a/b).
+Parameters in ``extra``: rho, m_visc, c_nu, gap, ``damage_active`` (False: zeta frozen at zeta_0),
+``stability_check`` (warn | error | off; k against the limit of the explicit elastic and contact
+forces, stability.py; docs/models.md, "Stability of the explicit terms"), ``elastic_term`` =
+``explicit`` (the thesis) or ``implicit`` (a deviation, NOT the thesis scheme: elastic and contact
+forces at u_{n-1} + k v_n, a semismooth Newton solve per step, prefix ``mech_``),
+``initial_damage`` (a key of ``builders["zeta0"]``, Example 2's cases a/b).
 
 Output: von Mises of the total stress zeta_n A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (DG0);
 history columns v_L2, the maximal interpenetration (u.nu - gap)_+ over the Gamma_C vertices and
@@ -135,7 +135,7 @@ class FullyDamageableContact(TimeStepper):
             else:
                 self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context,
                                          constant_matrix=False, defaults=MECH_DEFAULTS)
-        elif self.elastic_term == "implicit":  # G33 deviation
+        elif self.elastic_term == "implicit":  # deviation from the thesis scheme
             F = implicit_velocity_residual(self.v, w, *args)
             self.mech = NonlinearSolver(F, self.v, self.bcs, mech_prefix, self.context)
         else:
@@ -143,7 +143,7 @@ class FullyDamageableContact(TimeStepper):
                              f"got {self.elastic_term!r}")
         self.stability = self._stability_check(V, x, ds(GAMMA_C))
 
-        # output: von Mises of the total stress (PROBLEMS.md 1.9), DG0
+        # output: von Mises of the total stress (docs/models.md, "Output conventions"), DG0
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
         sigma = total_stress(self.v, self.u, self.zeta, p.E, p.nu, self.m_visc, p.L_trunc,
@@ -188,7 +188,7 @@ class FullyDamageableContact(TimeStepper):
             mech_its = self._timed("velocity", self.mech.solve, self.v)            # (3.159)
             stats = {"damage_its": damage_its, "mech_its": mech_its}
         else:
-            snes_its = self._timed("velocity", self.mech.solve)                     # G33
+            snes_its = self._timed("velocity", self.mech.solve)                     # implicit
             stats = {"damage_its": damage_its, "snes_its": snes_its}
         np.add(u_old, self.k * v, out=u)                                          # (3.160)
         self.profiles.sample(self.zeta, self.t)
@@ -236,11 +236,11 @@ class FullyDamageableContact(TimeStepper):
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
 
-    # -- stability of the explicit elastic and contact forces (PROBLEMS.md 1.8)
+    # -- stability of the explicit elastic and contact forces (docs/models.md, section 3.3)
     def _stability_check(self, V, x, dsC) -> dict:
         """k_max of the explicit scheme (undamaged body, Gamma_C fully in contact: conservative)
         compared with k according to ``stability_check``; {} when off. The implicit variant
-        (G33) is reported against the same k_max but never warned about."""
+        (elastic_term = implicit) is reported against the same k_max but never warned about."""
         action = x.get("stability_check", "warn")
         if action == "off":
             return {}

@@ -1,7 +1,7 @@
 """The models by id: their time stepper, the contact role of their Gamma_C, and default data.
 
-The default data of a model are a generic starting point (those of the model's first thesis
-example); a problem replaces any of them.
+The default data of a model are a generic starting point, not the data of a thesis example (the
+catalogue holds those); a problem replaces any of them. docs/models.md lists them per model.
 """
 from __future__ import annotations
 
@@ -70,7 +70,7 @@ def model(model_id: str) -> ModelInfo:
 
 
 def default_parameters(model_id: str) -> ModelParameters:
-    """Default data of a model (those of its first thesis example)."""
+    """Default data of a model (a generic starting point; docs/models.md, the model's section)."""
     damage_A = dict(kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.1,
                     lam_u=1000.0, lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False)
     if model(model_id).id == "2.1":

@@ -83,7 +83,8 @@ class ElastoViscoplasticFriction(TimeStepper):
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
                                                data.example_id)
 
-        # (4) damage obstacle step, source from step n-1 (G17: variant A, no sigma dependence)
+        # (4) damage obstacle step, source from step n-1 (variant A, no sigma dependence:
+        # docs/models.md, section 2.4)
         self.damage = self.obstacle_damage_step()
 
         self.von_mises = fem.Function(compat.scalar_dg0(msh), name="von_mises")
@@ -106,7 +107,7 @@ class ElastoViscoplasticFriction(TimeStepper):
     def _initial_state(self) -> dict:
         self.interpolate_zeta0(self.zeta)
         self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}  # u_0 = 0, sigma_0 = 0 (G19 b: the first step absorbs f_N(0))
+        return {}  # u_0 = 0, sigma_0 = 0: the first step absorbs f_N(0) (docs/models.md, 2.4)
 
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array

@@ -14,7 +14,7 @@ from damage_dolfinx import compat
 def form_callbacks(F, J, u, bcs, jacobian_split=None):
     """(residual, jacobian, b, A) callbacks for SNESSolver from UFL forms F(u; w), J = dF/du.
 
-    The pattern of PROBLEMS.md / fenicsx-patterns section 2: the SNES iterate is copied into
+    The usual DOLFINx pattern for a SNES: the SNES iterate is copied into
     ``u`` before assembly, Dirichlet rows are set to x - g so that the BC holds at convergence.
     ``jacobian_split`` = (J_constant, J_varying) with J = J_constant + J_varying, J_constant
     independent of u and of time (no Function in it): J_constant is assembled once (with the

@@ -1,7 +1,7 @@
 """Constitutive pieces of the thesis, as UFL expressions (plane stress, small strain).
 
 Each function is a pure map of UFL expressions; the numbers in brackets are thesis equations,
-the section numbers refer to ``PROBLEMS.md``. ``B``, ``Phi_L``, ``split_norms_sq`` and
+stated in docs/models.md ("Common notation"). ``B``, ``Phi_L``, ``split_norms_sq`` and
 ``von_mises`` take the dimension from their tensor argument: 2x2 gives the thesis' plane-stress
 expressions unchanged, 3x3 the 3-D ones of ``constitutive3d.py`` (issue 17).
 """
@@ -13,7 +13,7 @@ import ufl
 
 from damage_dolfinx.numerics import constitutive3d
 
-#: regulariser under the square root of the principal-strain formula (PROBLEMS.md 1.3)
+#: regulariser under the square root of the principal-strain formula (tension/compression split)
 SPLIT_EPS = 1e-30
 
 
@@ -78,8 +78,8 @@ def split_norms_sq(e):
 
 
 def von_mises(s):
-    """Plane-stress von Mises value sqrt(s11^2 - s11 s22 + s22^2 + 3 s12^2) (PROBLEMS.md 1.9);
-    the 3-D value sqrt(3/2 dev(s):dev(s)) for a 3x3 tensor."""
+    """Plane-stress von Mises value sqrt(s11^2 - s11 s22 + s22^2 + 3 s12^2) (docs/models.md,
+    "Output conventions"); the 3-D value sqrt(3/2 dev(s):dev(s)) for a 3x3 tensor."""
     if _dim(s) == 3:
         return constitutive3d.von_mises(s)
     return ufl.sqrt(s[0, 0] ** 2 - s[0, 0] * s[1, 1] + s[1, 1] ** 2 + 3.0 * s[0, 1] ** 2 + 1e-300)

@@ -2,7 +2,7 @@
 expressions of 3x3 tensors. ``constitutive.py`` dispatches to them on the tensor's shape, so a
 stepper takes the dimension from its mesh; the 2-D expressions are untouched.
 
-The thesis is 2-D (PROBLEMS.md Section 0, "2D, plane stress"); these are the standard 3-D
+The thesis is 2-D, plane stress (docs/models.md, "Common notation"); these are the standard 3-D
 objects the model reduces from: isotropic Hooke's law, whose plane-stress reduction is B (2.36),
 and the tension/compression split of Section 1.3 (thesis (1.4)) from the eigenvalues of a
 symmetric 3x3 strain.
@@ -55,7 +55,8 @@ def principal_strains(e):
 
 def split_norms_sq(e):
     """(|eps^+|^2, |eps^-|^2) of a symmetric 3x3 strain: sums of the squared positive / negative
-    eigenvalues (PROBLEMS.md 1.3), evaluated explicitly (never differentiated)."""
+    eigenvalues (the tension/compression split of the damage source), evaluated explicitly
+    (never differentiated)."""
     ls = principal_strains(e)
     pos = sum(ufl.max_value(l, 0.0) ** 2 for l in ls)
     neg = sum(ufl.min_value(l, 0.0) ** 2 for l in ls)
@@ -64,6 +65,6 @@ def split_norms_sq(e):
 
 def von_mises(s):
     """3-D von Mises value sqrt(3/2 dev(s):dev(s)); equal to the plane-stress formula of
-    PROBLEMS.md 1.9 when s_i3 = 0."""
+    docs/models.md ("Output conventions") when s_i3 = 0."""
     d = ufl.dev(s)
     return ufl.sqrt(1.5 * ufl.inner(d, d) + 1e-300)

@@ -1,4 +1,4 @@
-"""Contact laws (PROBLEMS.md 1.5) as UFL expressions.
+"""Contact laws (docs/models.md, "Normal compliance" and "Tresca friction") as UFL expressions.
 
 Normal compliance, frictionless: -sigma_nu = p_nu(u_nu - gap), p_nu(r) = c_nu r_+; its weak term
 int_{Gamma_C} p_nu(u.nu - gap) w.nu ds is semismooth, Newton uses the UFL derivative

@@ -1,4 +1,5 @@
-"""Damage source functions (1.3), (1.4) and the discrete damage step (PROBLEMS.md 1.3-1.4).
+"""Damage source functions (1.3), (1.4) and the discrete damage step (docs/models.md, "The
+damage step").
 
 The step is either the linear PDE solve (1.5) (Sections 2.1, 2.3) with a matrix factorised once,
 or the obstacle problem over K^h = {zeta_star <= zeta <= 1} solved by PETSc SNES
@@ -47,7 +48,7 @@ def fast_path_counts(stepper) -> dict:
     return step.counts() if hasattr(step, "counts") else {}
 
 
-#: SNES defaults of the obstacle step (PROBLEMS.md 1.4); override with -damage_snes_* options.
+#: SNES defaults of the obstacle step; override with -damage_snes_* options.
 #: The reduced systems (inactive set) are mass-dominated, M + k kappa K: CG + Jacobi to rtol 1e-12
 #: solves them in a few iterations without a factorisation per Newton step (measured on 2.2 Ex. 1,
 #: n = 64, k = 0.002: damage steps 6.3 s with MUMPS LU, 0.9 s with CG + Jacobi, same fields).

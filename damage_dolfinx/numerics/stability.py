@@ -1,4 +1,5 @@
-"""Time-step limit of the explicit elastic/contact force (PROBLEMS.md 1.8).
+"""Time-step limit of the explicit elastic/contact force (docs/models.md, "Stability of the
+explicit terms").
 
 The dynamic schemes of Sections 3.1-3.3 (and the quasistatic one of 2.2) take the elastic force,
 and in 3.1/3.3 the contact force, from step n-1 while inertia and viscosity are implicit:
@@ -43,7 +44,7 @@ from damage_dolfinx import compat
 from damage_dolfinx.numerics.constitutive import B, eps
 from damage_dolfinx.parameters import InputError
 
-#: safety factor of the suggested time step (PROBLEMS.md 1.8: return 0.8 k_max)
+#: safety factor of the suggested time step (0.8 k_max)
 SAFETY = 0.8
 
 #: PETSc/SLEPc options prefix of the eigenvalue solvers
@@ -57,7 +58,7 @@ EIG_TOL = 1e-3
 
 # ---------------------------------------------------------------------------- closed forms
 def critical_time_step(omega2_max: float, m_visc: float) -> float:
-    """k_max = 1/m + sqrt(1/m^2 + 4/omega^2) (PROBLEMS.md 1.8); m_visc = inf gives 2/omega,
+    """k_max = 1/m + sqrt(1/m^2 + 4/omega^2) (proportional damping); m_visc = inf gives 2/omega,
     omega^2 = 0 gives inf (no explicit stiffness)."""
     if not omega2_max > 0:
         return math.inf
@@ -309,7 +310,7 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
 
 
 def estimate_k_max(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal=None) -> float:
-    """k_max of the explicit elastic (+ normal compliance on dsC) force on V (PROBLEMS.md 1.8).
+    """k_max of the explicit elastic (+ normal compliance on dsC) force on V (module docstring).
 
     Without contact (c_nu = 0 or dsC None) this is critical_time_step(omega^2_max, m_visc) with
     omega^2_max the largest eigenvalue of (K_B, M_rho). With contact the contact stiffness

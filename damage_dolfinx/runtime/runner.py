@@ -361,7 +361,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
 
 
 def auto_amplification(stepper, diameter) -> float:
-    """G40: the factor that makes the largest displacement 10% of the domain diameter."""
+    """The factor that makes the largest displacement 10% of the domain diameter (where the
+    thesis gives none)."""
     u = stepper.u.x.array.reshape(-1, 2)
     umax = stepper.comm.allreduce(float(np.max(np.linalg.norm(u, axis=1))) if u.size else 0.0,
                                   op=MPI.MAX)

@@ -189,12 +189,13 @@ def gather_cells(u_disp, field, amplification: float = 0.0):
 def plot_fields(u_disp, fields, path, amplification=1.0, title="", outline=None, mesh_lines=False,
                 zeta_star=None):
     """One PNG of ``fields`` ((Function, label) pairs) on the configuration x + amplification * u
-    (PROBLEMS.md 1.9), drawn by figstyle (damage on [zeta*, 1], round factor in the title).
+    (docs/models.md, "Output conventions"), drawn by figstyle (damage on [zeta*, 1], round
+    factor in the title).
     ``mesh_lines``: a thesis "deformed mesh" figure -- the mesh edges on the deformed body over
     the undeformed outline, no colour field. The panel data are saved next to the PNG
     (``.npz``) so that thesis pairs can be re-rendered on a shared scale. Collective."""
     from damage_dolfinx.viz import figstyle
-    amplification = figstyle.drawn_amplification(amplification)  # e.g. the automatic G40 one
+    amplification = figstyle.drawn_amplification(amplification)  # e.g. the automatic one
     if zeta_star is None:
         zeta_star = _run_zeta_star(path)
     gathered = [gather_cells(u_disp, f, amplification) for f, _ in fields]

@@ -16,7 +16,8 @@ where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet cond
   algebraic (:class:`AlgebraicResidual`: one matrix-vector product per iteration, no assembly);
   linear solves by Cholesky (PETSc's in serial, MUMPS in parallel), re-factorised only when the
   Jacobian changes (i.e. when the stick set changes).
-* :class:`Uzawa` (2.98) with the corrections of G8: lambda_{s+1} = P(lambda_s + rho g v_tau),
+* :class:`Uzawa` (2.98) with two misprints corrected (docs/models.md, section 2.2):
+  lambda_{s+1} = P(lambda_s + rho g v_tau),
   P(x) = x / max(1, |x|); the unregularised problem (needs Gamma_D: a must be coercive).
 * :class:`PenaltyDuality`: the Bermudez-Moreno iteration on the regularised problem, as in the
   thesis: Phi_eps(v_tau) = omega v_tau + q, q_{s+1} = (G - omega I)_lambda(v_tau + lambda q_s),

@@ -104,7 +104,8 @@ class _IterativeFrictionSolver:
 
 
 class Uzawa(_IterativeFrictionSolver):
-    """(2.98) with G8: a(v_{s+1}, w) + sum_i m_i g_i lambda_{s,i} w_tau,i = l(w);
+    """(2.98) with its misprints corrected (docs/models.md, section 2.2):
+    a(v_{s+1}, w) + sum_i m_i g_i lambda_{s,i} w_tau,i = l(w);
     lambda_{s+1} = P(lambda_s + rho g v_{s+1,tau}), P(x) = x / max(1, |x|). The multiplier is
     kept between time steps (warm start)."""
 
