@@ -1,6 +1,6 @@
 """The models by id: their time stepper, the contact role of their Gamma_C, and default data.
 
-The default data of a model are a generic starting point, not the data of a thesis example (the
+The default data of a model are a generic starting point, not necessarily a thesis example's (the
 catalogue holds those); a problem replaces any of them. docs/models.md lists them per model.
 """
 from __future__ import annotations
