@@ -35,7 +35,7 @@ def _wall_times(doc, fig_index, conv_index):
     doc.markdown_table("| run | status | wall time [s] |\n|---|---|---|\n"
                        + "".join(f"| {name} | {status} | {t:.1f} |\n" for name, status, t in rows)
                        + f"| **total** | | **{total:.0f}** ({total / 3600:.2f} h) |\n")
-    check = REFERENCE / "reproduction_issue18" / "reproduction_check.md"
+    check = REFERENCE / "reproduction" / "reproduction_check.md"
     if check.is_file():
         doc.para("**The committed one-command reproduction**: `make convergence NP=2` and `make "
                  "figures NP=2` on one checkout, each once, on a quiet 2-core machine, compared "
@@ -127,10 +127,8 @@ def _step_floor(doc):
     """Per-step cost of every problem against one SpMV / CG iteration / Cholesky solve."""
     doc.anchor_heading(2, "Per-step cost against its floor", "step-floor")
     folder = REFERENCE / "step_floor"
-    # the newest record of each size first
-    tables = [(label, next((folder / f"step_floor_{tag}{suffix}.md"
-                            for suffix in ("_s10", "_s9", "_s8", "_vi_after", "_after")
-                            if (folder / f"step_floor_{tag}{suffix}.md").is_file()), None))
+    # the newest record of each size: step_floor_<tag>_<date>.md, the ISO date sorts last
+    tables = [(label, max(folder.glob(f"step_floor_{tag}_*.md"), default=None))
               for label, tag in (("about 4k dofs (n = 45)", "n45"),
                                  ("reference size (n = 255, 131k dofs)", "n255"))]
     tables = [(label, t) for label, t in tables if t is not None]
@@ -150,10 +148,6 @@ def _step_floor(doc):
     for label, table in tables:
         doc.para(f"**{label}**, from `{_shown(table)}`:")
         doc.markdown_table(table.read_text())
-        if table.stem.endswith("_vi_after"):
-            doc.note("Measured on the shared machine at load 2-4: the wall times and the floors "
-                     "are inflated; the CPU column and the damage-step split are the solid "
-                     "numbers (benchmarks/README.md, the damage obstacle step's fast path).")
 
 
 def _threed_scaling(doc):
