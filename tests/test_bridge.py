@@ -1,6 +1,6 @@
 """Section 2.1 Example 3 (masonry arch bridge, GitHub issue 3): geometry, loads, the collapse
 criterion checked against the saved fields, and serial = mpirun -n 2. Coarse meshes; the thesis-
-size run and the sensitivity study live in benchmarks/bridge_*.py."""
+size run and the sensitivity study live in benchmarks/studies/bridge_*.py."""
 import csv
 import json
 import math

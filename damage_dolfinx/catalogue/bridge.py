@@ -25,7 +25,7 @@ from damage_dolfinx import ModelParameters
 #: 89.25, 4000 -> 84, 5500 -> 104.5 kN (recalibrated with the bounded damage step, issue 16:
 #: same rate). It holds for the thesis's k = 0.001 only (k = 0.0005 -> 83.25 kN, 0.00025 ->
 #: 79.9 kN); the mesh matters less (h = 0.1 ... 0.025: 94.5, 94.5, 94.5, 90, 90 kN).
-#: benchmarks/bridge_sensitivity.py --calibrate reproduces it.
+#: benchmarks/studies/bridge_sensitivity.py --calibrate reproduces it.
 LOAD_RATE = 4500.0
 
 
@@ -121,7 +121,7 @@ def examples():
 #: the barrel vault (issue 17): width [m] and default element size [m]
 VAULT_WIDTH = 1.0
 VAULT_H = 0.1
-#: keyword arguments of barrel_vault besides h, read when the mesh is built (benchmarks/vault_3d.py
+#: keyword arguments of barrel_vault besides h, read when the mesh is built (benchmarks/studies/vault_3d.py
 #: sets other widths and plane-strain ends here; the catalogue entry is W = 1 m, free ends)
 VAULT_GEOMETRY = {"width": VAULT_WIDTH}
 

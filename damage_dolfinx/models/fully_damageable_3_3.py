@@ -59,12 +59,12 @@ from damage_dolfinx.models.base import ProblemData, TimeStepper
 MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
                  "ksp_max_it": 5000, "ksp_initial_guess_nonzero": True}
 
-#: issue 18 (per-step cost): the matrix of (3.159) from the nodal zeta_n by a precomputed sparse
+#: per-step cost: the matrix of (3.159) from the nodal zeta_n by a precomputed sparse
 #: map instead of a re-assembly (serial; equal to round-off); with Phi_L = identity the
 #: right-hand side too (FAST_RHS); CG started from the cubic extrapolation
 #: 4 v_{n-1} - 6 v_{n-2} + 4 v_{n-3} - v_{n-4} instead of v_{n-1} (same solution to rtol 1e-12;
-#: wrench, T = 0.05: 15.0 -> 9.1 iterations per step; linear 11.4, quadratic 10.1). Switches for
-#: benchmarks/step_profile_3_3.py, which times the step both ways.
+#: wrench, T = 0.05: 15.0 -> 9.1 iterations per step; linear 11.4, quadratic 10.1). Switches to time
+#: or check the step both ways.
 FAST_MATRIX = True
 FAST_RHS = True
 VELOCITY_EXTRAPOLATION = True

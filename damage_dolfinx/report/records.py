@@ -1,14 +1,14 @@
 """The report's benchmark records (report.py builds the document): wall times of the
 reproduction, the performance record, the friction CPU comparison (thesis Tables 2.2/2.3), the
-bridge failure load, the per-step cost against its floor (benchmarks/step_floor.py) and the 3-D
-scaling record (benchmarks/threed_scaling.py). Each reads the committed output
+bridge failure load, the per-step cost against its floor (benchmarks/performance/step_floor.py) and the 3-D
+scaling record (benchmarks/performance/threed_scaling.py). Each reads the committed output
 in ``benchmarks/reference_output/`` (or the results folder) and names the command behind it.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]  # the checkout (damage_dolfinx/report/records.py)
 REFERENCE = REPO / "benchmarks" / "reference_output"
 
 
@@ -39,7 +39,7 @@ def _wall_times(doc, fig_index, conv_index):
     if check.is_file():
         doc.para("**The committed one-command reproduction**: `make convergence NP=2` and `make "
                  "figures NP=2` on one checkout, each once, on a quiet 2-core machine, compared "
-                 "with the committed tables by `python benchmarks/reproduction_check.py` (target: "
+                 "with the committed tables by `python benchmarks/reproduction/reproduction_check.py` (target: "
                  "both together within 40 minutes; every error equal to the committed one to a "
                  f"relative 1e-6). From the committed record `{check.name}`:")
         text = check.read_text()
@@ -71,12 +71,12 @@ def _explain_check(doc, record_path):
 
 
 def _performance(doc, results):
-    """Time per step vs dofs, serial and 2 ranks (benchmarks/performance.py)."""
+    """Time per step vs dofs, serial and 2 ranks (benchmarks/performance/performance.py)."""
     doc.anchor_heading(2, "Performance: time per step vs dofs, serial and 2 MPI ranks",
                        "performance")
     for table in (results / "performance" / "performance.md", REFERENCE / "performance" / "performance.md"):
         if table.is_file():
-            doc.para(f"`python benchmarks/performance.py`, from `{_shown(table)}`.")
+            doc.para(f"`python benchmarks/performance/performance.py`, from `{_shown(table)}`.")
             doc.markdown_table(table.read_text())
             doc.note("Columns: dofs (u) = displacement unknowns; serial / 2 ranks = wall time per "
                      "time step; speed-up = serial over 2-rank time per step; `(ref)` marks the "
@@ -95,7 +95,7 @@ def _bridge(doc, s, path):
              f"{s.get('n_mechanism_hinges', s['n_hinges'])} of them mechanism hinges (rotation "
              f"in the collapse step at least 0.2 x the largest); "
              f"calibration: {s.get('calibrated')}; source `{_shown(path)}` "
-             f"(`benchmarks/bridge_collapse.py`).")
+             f"(`benchmarks/studies/bridge_collapse.py`).")
 
 
 def _friction_cpu(doc):
@@ -109,14 +109,14 @@ def _friction_cpu(doc):
     table = REFERENCE / "friction_cpu" / "cpu.md"
     if table.is_file():
         doc.para("CPU comparison of the three friction solvers (thesis Tables 2.2/2.3; "
-                 "`python benchmarks/friction_cpu_2_2.py`, committed output "
+                 "`python benchmarks/studies/friction_cpu_2_2.py`, committed output "
                  "`benchmarks/reference_output/friction_cpu/cpu.md`):")
         doc.markdown_table(table.read_text())
         doc.note(explain)
     stick = REFERENCE / "friction_cpu_stick" / "cpu.md"
     if stick.is_file():
         doc.para("The same with stick-slip (friction bound g = 200 instead of 5, Uzawa step "
-                 "rho = 1e-3 from a sweep of rho at n = 16; `python benchmarks/friction_cpu_2_2.py "
+                 "rho = 1e-3 from a sweep of rho at n = 16; `python benchmarks/studies/friction_cpu_2_2.py "
                  "--set g_fric=200 rho_uzawa=1e-3`, output "
                  "`benchmarks/reference_output/friction_cpu_stick/cpu.md`):")
         doc.markdown_table(stick.read_text())
@@ -133,9 +133,9 @@ def _step_floor(doc):
                                  ("reference size (n = 255, 131k dofs)", "n255"))]
     tables = [(label, t) for label, t in tables if t is not None]
     if not tables:
-        doc.para("No per-step profile (`python benchmarks/step_floor.py`).")
+        doc.para("No per-step profile (`python benchmarks/performance/step_floor.py`).")
         return
-    doc.para("`python benchmarks/step_floor.py` (serial; each problem at its own k; steps after "
+    doc.para("`python benchmarks/performance/step_floor.py` (serial; each problem at its own k; steps after "
              "the first two, history scalars included). The floor is measured on the vector P1 "
              "matrix M + K of the same mesh: one sparse matrix-vector product, one CG + Jacobi "
              "iteration and one Cholesky solve (PETSc's). Target: at most 5x the floor at about "
@@ -160,7 +160,7 @@ def _threed_scaling(doc):
                         ("scaling_dynamic", "dynamic (3.1-ex1-3d)")):
         table, plot = folder / f"{stem}.md", folder / f"{stem}.png"
         if table.is_file():
-            doc.para(f"**{label}**, `python benchmarks/threed_scaling.py`, from `{_shown(table)}`:")
+            doc.para(f"**{label}**, `python benchmarks/performance/threed_scaling.py`, from `{_shown(table)}`:")
             doc.markdown_table(table.read_text())
             shown = True
         if plot.is_file():
@@ -172,4 +172,4 @@ def _threed_scaling(doc):
                  f"`{_shown(extrapolation)}`:")
         doc.markdown_table(extrapolation.read_text())
     if not shown:
-        doc.para("No 3-D scaling record (`python benchmarks/threed_scaling.py`).")
+        doc.para("No 3-D scaling record (`python benchmarks/performance/threed_scaling.py`).")

@@ -274,8 +274,8 @@ def _figure_run(job, ranks, runs, out, resume) -> tuple:
 
 
 def _bridge_force_displacement(mode, out, np_, index):
-    """Figure 2.7 (force-displacement curve of the arch) from benchmarks/bridge_collapse.py."""
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bridge_collapse.py"
+    """Figure 2.7 (force-displacement curve of the arch) from benchmarks/studies/bridge_collapse.py."""
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "studies" / "bridge_collapse.py"
     if not script.is_file():
         return
     folder = out / "runs" / "bridge_collapse"
@@ -290,7 +290,7 @@ def _bridge_force_displacement(mode, out, np_, index):
     with open(folder / "log.txt", "w") as f:
         code = subprocess.call(argv, stdout=f, stderr=subprocess.STDOUT, env=env)
     command = (f"mpirun -n {np_} " if np_ > 1 else "") + \
-        f"python benchmarks/bridge_collapse.py {' '.join(options)} --out {folder}"
+        f"python benchmarks/studies/bridge_collapse.py {' '.join(options)} --out {folder}"
     index["runs"].append({"example": "2.1-ex3", "variant": "force-displacement",
                           "command": command, "returncode": code,
                           "wall_time_s": round(time.perf_counter() - start, 2), "folder": str(folder)})
