@@ -37,3 +37,26 @@ def test_readings_summary_is_the_scripts_output():
     readings = (BENCH / "readings.md").read_text()
     missing = [row for row in rows if row not in readings]
     assert not missing, missing
+
+
+def test_readme_tables_come_from_records():
+    """Every table of benchmarks/README.md marked <!-- record: PATH --> is copied line for line
+    from that record (PATH relative to benchmarks/): no number in it is typed by hand."""
+    lines = (BENCH / "README.md").read_text().splitlines()
+    marked = 0
+    for i, line in enumerate(lines):
+        if not line.startswith("<!-- record: "):
+            continue
+        record = BENCH / line[len("<!-- record: "):].removesuffix(" -->").strip()
+        assert record.is_file(), record
+        source = set(record.read_text().splitlines())
+        table = []
+        for row in lines[i + 1:]:
+            if not row.startswith("|"):
+                break
+            table.append(row)
+        assert len(table) >= 3, (record, "no table after the marker")
+        typed = [row for row in table if row not in source]
+        assert not typed, (record, typed)
+        marked += 1
+    assert marked >= 5
