@@ -1,4 +1,4 @@
-"""Masonry barrel vault (issue 17): the thesis arch ring (Section 2.1 Example 3, PROBLEMS.md G3)
+"""Masonry barrel vault: the thesis arch ring (Section 2.1 Example 3, PROBLEMS.md G3)
 extruded along z by a width W, gmsh, tetrahedra.
 
 The 2-D ring of ``geometries/bridge.py`` (structured n_r x n_theta grid, one fixed diagonal per

@@ -8,7 +8,7 @@ here=$(cd "$(dirname "$0")" && pwd); repo=$(dirname "$here")
 [ "$(id -u)" = 0 ] || { echo "cross-version: needs root (debootstrap, chroot)" >&2; exit 2; }
 md=${1:-$repo/results/cross_version.md}
 mkdir -p "$(dirname "$md")"
-work=$(mktemp -d /tmp/cross-version.XXXXXX)
+work=$(mktemp -d -t cross-version.XXXXXX)
 copy_clone "$repo" "$work/clone"  # one snapshot of HEAD for all three versions
 git -C "$repo" rev-parse --short HEAD > "$work/commit"
 (cd "$work/clone" && make -s setup >/dev/null && .venv/bin/python benchmarks/platforms/cross_version.py run --out "$work/bookworm")

@@ -1,16 +1,16 @@
-"""Record (or check) fixed small 2-D runs, the guard of issue 17: the 3-D generalisation of the
+"""Record (or check) fixed small 2-D runs, the guard of the 3-D extension: the 3-D generalisation of the
 models must leave every 2-D result identical to round-off, for every problem (Sections 2.1-3.3).
 
     .venv/bin/python tests/reference_2d.py --record   # writes tests/data/reference_2d.json
     .venv/bin/python tests/reference_2d.py            # compares a fresh run with it
 
 The reference in tests/data/reference_2d.json was recorded at commit 0c50637, before the
-second 3-D slice (Tresca on a tangent plane, contact, the vault) and before the issue-18 damage
+second 3-D slice (Tresca on a tangent plane, contact, the vault) and before the damage
 fast path; at 0c50637 the 2.1-ex1 and 2.2-ex1 runs equalled the first reference (549c1d6, before any
-issue-17 change) to 0.0. tests/test_3d.py::test_2d_runs_unchanged repeats the comparison.
+3-D change) to 0.0. tests/test_3d.py::test_2d_runs_unchanged repeats the comparison.
 
-The runs are made with the PETSc options of ``GUARD_OPTIONS``: they switch off the accelerations
-of issue 18 that change results at solver tolerance (not round-off), so that this guard isolates
+The runs are made with the PETSc options of ``GUARD_OPTIONS``: they switch off the per-step
+accelerations that change results at solver tolerance (not round-off), so that this guard isolates
 the 3-D generalisation; those accelerations are checked against the plain path by their own tests.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 17, 3-D contact: normal compliance on a plane face against its closed form, the 3-D
+"""3-D contact: normal compliance on a plane face against its closed form, the 3-D
 contact monitor, the wrench plate's facet tags against the outline times the thickness, and
 serial = 2 ranks for the 3-D contact examples (2.3-ex1-3d, 3.1-ex1-3d, 3.3-ex1-3d, 3.3-ex3-3d)
 at tiny meshes. Every test takes seconds."""
@@ -27,7 +27,7 @@ def _block(n, comm=MPI.COMM_WORLD):
 
 def test_block_on_normal_compliance_foundation_closed_form():
     """A block pressed by a uniform pressure p onto a normal-compliance foundation
-    (PROBLEMS.md 1.5: -sigma_nu = c_nu (u.nu - gap)_+), frictionless, on rollers at x = 0 and
+    (normal compliance: -sigma_nu = c_nu (u.nu - gap)_+), frictionless, on rollers at x = 0 and
     y = 0, free at x = 1, y = 1: uniaxial stress sigma_zz = -p, so the foundation is pressed in
     uniformly by u.nu = p/c_nu and u = (nu p x/E, nu p y/E, -p/c_nu - p z/E), linear, which P1
     reproduces to round-off. Solved with the 2.3 residual (2.137, no memory) and the package's

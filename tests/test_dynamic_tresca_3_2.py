@@ -69,7 +69,7 @@ def test_three_friction_solvers_agree(tmp_path):
         run_cli(base + ["--set", f"friction_solver={solver}", "--out", tmp_path / solver])
         runs[solver] = load_run(tmp_path / solver)
     summary, newton = runs["newton"]
-    assert 0.02 <= summary["k_max"] < 0.0201  # PROBLEMS.md 1.8: k_max -> 2/m_visc from above
+    assert 0.02 <= summary["k_max"] < 0.0201  # k_max -> 2/m_visc from above
     for solver in ("uzawa", "penalty-duality"):
         summary, fields = runs[solver]
         assert summary["iterations"]["friction_solver"] == solver

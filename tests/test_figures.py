@@ -1,4 +1,4 @@
-"""Figure style rules (issue 19): damage colour bars never autoscaled, amplification factors
+"""Figure style rules: damage colour bars never autoscaled, amplification factors
 round, one stress scale within a thesis pair, and the fidelity comparison of the thesis tables."""
 import json
 import math
@@ -143,7 +143,7 @@ def test_convergence_error_label_in_mathtext():
 
 def test_every_plot_goes_through_figstyle():
     """No module draws with matplotlib directly: figure sizes, fonts, mathtext, colour scales and
-    layout come from figstyle (issue 19)."""
+    layout come from figstyle."""
     import re
     files = list((REPO / "damage_dolfinx").rglob("*.py")) + list((REPO / "benchmarks").rglob("*.py"))
     direct = [p.name for p in files if p.name != "figstyle.py" and

@@ -1,4 +1,4 @@
-"""The masonry barrel vault in 3-D (issue 17, 2.1-ex3-vault): gmsh geometry (counts of the
+"""The masonry barrel vault in 3-D (2.1-ex3-vault): gmsh geometry (counts of the
 structured grid, tag areas), equilibrium of the line load across the width, the width-averaged
 section rotation, a coarse run that collapses with its hinge lines re-derived from the saved
 fields, and serial = 2 ranks. Coarse meshes (h = 0.2); the study is benchmarks/studies/vault_3d.py."""

@@ -1,6 +1,6 @@
-"""Fault injection (issue 20): what a run survives, measured on the real command line.
+"""Fault injection: what a run survives, measured on the real command line.
 
-    flock /tmp/team/heavy.lock python benchmarks/faults/faults.py [--only kill disk ...]
+    python benchmarks/faults/faults.py [--only kill disk ...]
         [--kills 10] [--out results/faults]
 
 Every case starts `damage-dolfinx run` (serially or under mpirun -n 2), injects one fault, records

@@ -1,4 +1,4 @@
-"""Time per step of every problem against its floor at the same size (issue 18, item 1).
+"""Time per step of every problem against its floor at the same size.
 
     .venv/bin/python benchmarks/performance/step_floor.py                    # ~4k dofs (n = 45), serial
     .venv/bin/python benchmarks/performance/step_floor.py --n 128 --only 3.2-ex1

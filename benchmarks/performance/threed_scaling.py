@@ -1,10 +1,10 @@
-"""3-D scaling record (issue 17): time per step, Krylov iterations per solve, peak memory per rank
+"""3-D scaling record: time per step, Krylov iterations per solve, peak memory per rank
 and set-up time against the number of unknowns, serially and on 2 ranks, for one quasistatic
 (2.1-ex1-3d) and one dynamic (3.1-ex1-3d) 3-D example, with the fitted exponent of time per step
 against dofs and the extrapolation to a 10^8-dof cluster run.
 
-    flock /tmp/team/heavy.lock .venv/bin/python benchmarks/performance/threed_scaling.py quasistatic --n 10 20 30 40
-    flock /tmp/team/heavy.lock .venv/bin/python benchmarks/performance/threed_scaling.py dynamic --n 12 20 30 40
+    .venv/bin/python benchmarks/performance/threed_scaling.py quasistatic --n 10 20 30 40
+    .venv/bin/python benchmarks/performance/threed_scaling.py dynamic --n 12 20 30 40
     .venv/bin/python benchmarks/performance/threed_scaling.py report     (tables, plots, extrapolation only)
 
 Each size is one ``damage-dolfinx run`` of a few steps (quasistatic k = 0.1, 4 steps; dynamic

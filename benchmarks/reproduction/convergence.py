@@ -23,7 +23,7 @@ parser.add_argument("--out", default=None)
 parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                     help="model parameter override, e.g. --set friction_law=coulomb (2.4-ex1 P2)")
 parser.add_argument("--reading", choices=("literal", "evidence"),
-                    help="thesis data literally or the evidence reading (issue 16)")
+                    help="thesis data literally or the evidence reading")
 args = parser.parse_args()
 overrides = dict(pair.split("=", 1) for pair in args.set)
 if args.reading:

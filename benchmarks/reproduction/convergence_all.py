@@ -22,7 +22,7 @@ p.add_argument("--resume", action="store_true",
                help="keep the runs that completed in an earlier invocation into the same OUT")
 p.add_argument("--reading", choices=("literal", "evidence"),
                help="thesis data literally or the evidence reading (default: each example's "
-                    "default_reading, issue 16)")
+                    "default_reading)")
 a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/convergence-quick" if a.quick else "results/convergence"))

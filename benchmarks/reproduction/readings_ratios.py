@@ -1,4 +1,4 @@
-"""Ratios ours / thesis per cell of a convergence study against a thesis table (issue 16).
+"""Ratios ours / thesis per cell of a convergence study against a thesis table.
 
     python benchmarks/reproduction/readings_ratios.py TABLE FOLDER [FOLDER ...] [--column error_v_L2]
                                          [--exclude N,K ...]
@@ -6,7 +6,7 @@
 
 ``--summary``: one row per thesis table for the committed thesis-size studies,
 reference_output/convergence (default reading) and reference_output/convergence-literal (the
-literal reading, where the default differs), as in the table of issue 16.
+literal reading, where the default differs): the summary table of benchmarks/readings.md.
 
 TABLE is a key of benchmarks/thesis_tables.json (2.4, 2.5, 2.6, 2.7, 3.1, 3.2); each FOLDER holds
 a study's errors.csv (damage-dolfinx converge). Prints, per folder, a markdown block: the cells

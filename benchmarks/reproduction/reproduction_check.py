@@ -1,5 +1,5 @@
 """Check a one-command reproduction (``make convergence`` + ``make figures``) against the committed
-results (issue 18): every error of every convergence study against
+results: every error of every convergence study against
 ``reference_output/convergence/<study>/summary.json``, and the wrench of Section 3.3 Example 3
 (the figures run ``runs/3.3-ex3``) against ``reference_output/wrench_3_3/wrench.json``.
 

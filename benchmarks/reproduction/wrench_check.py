@@ -1,5 +1,5 @@
 """Compare a wrench run (wrench_3_3.py's wrench.json) with the committed thesis-size reference
-(issue 18: the same maximum interpenetration, von Mises peak and min zeta to 1e-6 relative, at
+(the same maximum interpenetration, von Mises peak and min zeta to 1e-6 relative, at
 the same places).
 
     .venv/bin/python benchmarks/reproduction/wrench_check.py results/wrench_3_3/wrench.json

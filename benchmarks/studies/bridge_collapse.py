@@ -1,4 +1,4 @@
-"""Collapse of the masonry arch ring, thesis Section 2.1 Example 3 (GitHub issue 3), default case.
+"""Collapse of the masonry arch ring, thesis Section 2.1 Example 3, default case.
 
     mpirun -n 2 .venv/bin/python benchmarks/studies/bridge_collapse.py [--h 0.05] [--k 0.001]
         [--reading literal|evidence] [--set name=value ...] [--out results/bench/bridge]

@@ -1,7 +1,7 @@
-"""Issue 17, 3-D contact: wall times of the 3-D contact examples at their defaults, and the
+"""3-D contact: wall times of the 3-D contact examples at their defaults, and the
 direct/AMG crossover of the 3.1 velocity system (benchmarks/README.md "3-D: contact").
 
-    flock /tmp/team/heavy.lock .venv/bin/python benchmarks/studies/contact_3d.py [--examples] [--crossover]
+    .venv/bin/python benchmarks/studies/contact_3d.py [--examples] [--crossover]
 
 --examples: ``damage-dolfinx run <id>`` serially at the catalogue defaults for 2.3-ex1-3d,
 3.1-ex1-3d, 3.3-ex1-3d, 3.3-ex3-3d (figures and XDMF included): wall time, steps, dofs, k/k_max,

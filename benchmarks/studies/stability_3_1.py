@@ -1,10 +1,10 @@
-"""Time-step limits of the explicit elastic/contact force (PROBLEMS.md 1.8) and a measured onset.
+"""Time-step limits of the explicit elastic/contact force and a measured onset.
 
     [mpirun -n 2] .venv/bin/python benchmarks/studies/stability_3_1.py [--out DIR] [--quick]
 
 1. k_max of stability.py (SLEPc or power iteration) for the examples of Sections 3.1, 3.2 and 3.3
    on small meshes: 3.1 and 3.2 through their catalogue steppers (3.2 only if its catalogue is
-   there), 3.3 Ex. 1-2 from the PROBLEMS.md data directly (square (0,6)^2, layout of 3.1 Ex. 1;
+   there), 3.3 Ex. 1-2 from the thesis data directly (square (0,6)^2, layout of 3.1 Ex. 1;
    viscosity eta_*(zeta) B/m_visc taken undamaged).
 2. The measured onset for 3.1 Ex. 1 (G23, damage frozen, thesis load, T = 1): bisection on
    k/k_max with the chatter indicator max_n |second difference of ||v_n||_L2| / max_n ||v_n||
@@ -48,7 +48,7 @@ def catalogue_k_max(example_id, **mesh):
 
 
 def square_3_3(n, E, nu, rho, m_visc, c_nu):
-    """3.3 Ex. 1-2 setting: (0,6)^2, clamped at x = 0 and 6, contact below (PROBLEMS.md 3.3)."""
+    """3.3 Ex. 1-2 setting: (0,6)^2, clamped at x = 0 and 6, contact below (thesis Section 3.3)."""
     geo = rectangle(COMM, (0, 0), (6, 6), n, n, {
         GAMMA_D: lambda x: side(0, 0.0)(x) | side(0, 6.0)(x), GAMMA_N: side(1, 6.0),
         GAMMA_C: side(1, 0.0)})
@@ -116,10 +116,10 @@ def main():
                 break
     for n in ([4, 16] if quick else [4, 16, 32]):
         row = square_3_3(n, 100.0, 0.3, 2700.0, 1.0, 2e3)
-        row.update(example="3.3-ex1 (PROBLEMS data)", k=None)
+        row.update(example="3.3-ex1 (thesis data)", k=None)
         table.append(row)
         row = square_3_3(n, 7.1e9, 0.33, 2700.0, 1e6, 1e9)
-        row.update(example="3.3-ex2 (PROBLEMS data)", k=None)
+        row.update(example="3.3-ex2 (thesis data)", k=None)
         table.append(row)
 
     onsets = [measured_onset(n) for n in ([4] if quick else [4, 8])]

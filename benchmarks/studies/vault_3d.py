@@ -1,6 +1,6 @@
-"""The masonry barrel vault in 3-D (issue 17, example 2.1-ex3-vault) against the 2-D arch.
+"""The masonry barrel vault in 3-D (example 2.1-ex3-vault) against the 2-D arch.
 
-    flock /tmp/team/heavy.lock .venv/bin/python benchmarks/studies/vault_3d.py [--h 0.1]
+    .venv/bin/python benchmarks/studies/vault_3d.py [--h 0.1]
         [--cases arch2d vault thin plane_strain] [--out results/bench/vault_3d]
         [--ref benchmarks/reference_output/vault_3d] [--plot-only]
 
