@@ -115,7 +115,7 @@ def run_coarse(out, monkeypatch=None, np_=1):
         from damage_dolfinx.catalogue import bridge
         monkeypatch.setattr(bridge, "VAULT_GEOMETRY", dict(COARSE))
         return runner.run("2.1-ex3-vault", out, h=H, progress=False, figures=False)
-    code = ("import sys; from damage_dolfinx import runner; from damage_dolfinx.catalogue import "
+    code = ("import sys; from damage_dolfinx.runtime import runner; from damage_dolfinx.catalogue import "
             f"bridge; bridge.VAULT_GEOMETRY.update({COARSE!r}); runner.run('2.1-ex3-vault', "
             f"sys.argv[1], h={H}, progress=False, figures=False)")
     import subprocess
