@@ -21,7 +21,8 @@ KERNEL_EVENTS: SpMV, triangular solves, factorisations, vector operations): "ste
 solves" = step / (MatSolve per step x one Cholesky solve), "step over its kernels" = step /
 that kernel time, i.e. how far the step is above the arithmetic its own scheme performs.
 Serial. Writes
-benchmarks/reference_output/step_floor/step_floor_n<N>.json and .md (--out to change).
+benchmarks/reference_output/step_floor/step_floor_n<N>_<date>.json and .md (--out to change; the
+report shows the newest date of each size).
 """
 import argparse
 import sys
@@ -57,7 +58,8 @@ parser.add_argument("--steps", type=int, default=20)
 parser.add_argument("--warmup", type=int, default=2)
 parser.add_argument("--only", nargs="+")
 parser.add_argument("--out", default="benchmarks/reference_output/step_floor")
-parser.add_argument("--label", default="", help="suffix of the output files (e.g. before)")
+parser.add_argument("--label", default=time.strftime("%Y-%m-%d"),
+                    help="suffix of the output files (default: the date, YYYY-MM-DD)")
 args = parser.parse_args()
 comm = MPI.COMM_WORLD
 if comm.size != 1:
@@ -164,7 +166,7 @@ def profile(example) -> dict:
 
 
 rows = profile_rows(PROBLEMS, args.only, profile)
-stem = f"step_floor_n{args.n}" + (f"_{args.label}" if args.label else "")
+stem = f"step_floor_n{args.n}_{args.label}"
 lines = ["| example | dofs (u) | ms per step (wall / CPU) | split (ms) | SpMV / CG it / Cholesky "
          "solve (us) | step over SpMV / CG it / Cholesky solve | damage fast path: hits "
          "(unchanged) / SNES fallbacks | per step: solves / SpMVs / factorisations / PETSc "

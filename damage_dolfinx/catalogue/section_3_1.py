@@ -33,7 +33,7 @@ def zeta0_example2(x):
     return 0.1 + 0.9 * np.minimum(1.0, np.maximum(0.0, np.abs(x[0] - 1.5) - 0.2) / 1.3)
 
 
-#: evidence reading of Example 1 (issue 16, benchmarks/readings.md)
+#: evidence reading of Example 1 (benchmarks/readings.md)
 EVIDENCE_EX1 = Reading(
     overrides={"c_nu": 5e-5, "error_norm": "velocity_only"},
     assumptions=[

@@ -12,7 +12,7 @@ radial grid line j of the ring (n_r + 1 nodes on the structured mesh; on an unst
 nodes whose polar angle is nearest to theta_j); it has failed when the maximum of zeta_n over
 its nodes is <= zeta_star (+ ZETA_STAR_TOL). The failure load is P(t_n) at the first such step n.
 
-Damage bound (issue 16; ``damage_bound``): with the thesis data the source violates the sign
+Damage bound (``damage_bound``): with the thesis data the source violates the sign
 condition (2.11) (thesis lines 752-758: phi >= 0 for zeta <= zeta_star would need
 lam_D (1 - zeta_star)/zeta_star = 0.198 >= 0.5 lam_u |eps^+-|^2, i.e. strains below 9e-6), so the
 linear step (2.20) drives zeta_n far below zeta_star (-1200 at h = 0.05 before collapse) and the
@@ -31,7 +31,7 @@ with the consistent mass matrix it leaves checkerboard oscillations in the damag
 Hinges and the mechanism: bridge_sections.py (section damage D_j, its peaks, the rotation of
 each cross-section and which hinges move at collapse).
 
-3-D (issue 17, the barrel vault of geometries/vault.py, example 2.1-ex3-vault): the dimension
+3-D (the barrel vault of geometries/vault.py, example 2.1-ex3-vault): the dimension
 comes from the mesh. The ring is extruded along z by a width W; P is a line load per metre of
 width on the extruded load strip (traction 1000 P / L_N, L_N = strip area / W, so the total load
 is P W); self weight (0, -rho g, 0). A cross-section is the plane theta = theta_j (grid line j

@@ -144,7 +144,7 @@ def _step_floor(doc):
              "iteration, 4-40 CG iterations): the last two columns count, from PETSc's event "
              "log, the triangular-solve pairs, SpMVs and factorisations of a step and the time "
              "PETSc spends in its numerical kernels, and give the step over its own solves and "
-             "over its own arithmetic (benchmarks/README.md, 'per-step cost').")
+             "over its own arithmetic (benchmarks/README.md, 'Performance against the floor').")
     for label, table in tables:
         doc.para(f"**{label}**, from `{_shown(table)}`:")
         doc.markdown_table(table.read_text())

@@ -82,7 +82,7 @@ def _quick_options(ex) -> list:
 
 
 def _reading_options(reading) -> list:
-    """``--reading NAME`` (issue 16), or nothing for each example's default reading."""
+    """``--reading NAME``, or nothing for each example's default reading."""
     return ["--reading", reading] if reading else []
 
 
@@ -185,7 +185,7 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, rea
     """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``. With
     ``resume``, jobs that completed in an earlier invocation (same mode) are kept, not rerun.
 
-    Two lanes (issue 18): the SERIAL jobs (the wrench, 3.3-ex2: long serial loops) run one
+    Two lanes: the SERIAL jobs (the wrench, 3.3-ex2: long serial loops) run one
     after the other on one rank, while the other jobs run beside them on np_ - 1 ranks, and on
     np_ ranks once the serial lane is done. index.json lists the runs in catalogue order."""
     import threading

@@ -1,6 +1,6 @@
 """One figure style for every PNG of the package (thesis figures, histories, settings).
 
-Rules (GitHub issue 19), each applied here and nowhere else:
+Rules, each applied here and nowhere else:
 
 * damage on a fixed colour scale [zeta*, 1] -- never autoscaled -- with the label
   "zeta (1 = sound, zeta* = fully damaged)"; if the field leaves that range (the PDE damage law of
