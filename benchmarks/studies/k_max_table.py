@@ -1,7 +1,7 @@
 """The refused-k table: per problem, the stability limit k_max of its explicit terms at a small
 and at the reference mesh, and what a run at 1.5 k_max says (exit status and message).
 
-    python benchmarks/stability/k_max_table.py [--out benchmarks/reference_output/stability]
+    python benchmarks/studies/k_max_table.py [--out benchmarks/reference_output/stability]
 
 Writes k_max_table.json and k_max_table.md. k_max: the closed forms of 2.2 (2/m_visc) and 2.4
 (2/(1 - zeta*)), the eigenvalue estimate of the steppers of 3.1-3.3 (undamaged body, Gamma_C
