@@ -53,7 +53,9 @@ GUARD_OPTIONS = "-damage_vi_fast 0"
 
 def run_case(example_id, args, out: Path) -> dict:
     """History scalars and final fields of one run (same keys as the reference)."""
-    cmd = [sys.executable, "-m", "damage_dolfinx.cli", "run", example_id, *args,
+    # the recorded runs keep their k even where it exceeds k_max (3.3-ex2 at k = 0.01): the guard
+    # compares with the recording, bit for bit, not with a stable run
+    cmd = [sys.executable, "-m", "damage_dolfinx.cli", "run", example_id, *args, "--allow-unstable",
            "--no-figures", "--quiet", "--checkpoint-seconds", "0", "--out", str(out)]
     env = dict(os.environ, PETSC_OPTIONS=(os.environ.get("PETSC_OPTIONS", "") + " "
                                           + GUARD_OPTIONS).strip())
