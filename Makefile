@@ -66,30 +66,30 @@ docs: setup
 	@echo "documentation in $(DOCS_BUILD)/html/index.html"
 
 bench: setup
-	$(MPIRUN) $(PY) benchmarks/step_timing_2_1.py
-	$(PY) benchmarks/memory_cost_2_3.py
-	$(PY) benchmarks/friction_cpu_2_2.py
-	$(MPIRUN) $(PY) benchmarks/bridge_collapse.py
-	$(PY) benchmarks/bridge_sensitivity.py
+	$(MPIRUN) $(PY) benchmarks/performance/step_timing_2_1.py
+	$(PY) benchmarks/performance/memory_cost_2_3.py
+	$(PY) benchmarks/studies/friction_cpu_2_2.py
+	$(MPIRUN) $(PY) benchmarks/studies/bridge_collapse.py
+	$(PY) benchmarks/studies/bridge_sensitivity.py
 
 # All convergence studies at thesis resolution, references on $(NP) ranks (make convergence NP=4).
 convergence: setup
-	$(PY) benchmarks/convergence_all.py --np $(NP) --out $(OUT)/convergence $(if $(RESUME),--resume)
+	$(PY) benchmarks/reproduction/convergence_all.py --np $(NP) --out $(OUT)/convergence $(if $(RESUME),--resume)
 
 convergence-quick: setup
-	$(PY) benchmarks/convergence_all.py --quick --np $(NP) --out $(OUT)/convergence-quick $(if $(RESUME),--resume)
+	$(PY) benchmarks/reproduction/convergence_all.py --quick --np $(NP) --out $(OUT)/convergence-quick $(if $(RESUME),--resume)
 
 # Every thesis figure with a computed result (PNG named after the figure number).
 figures: setup
-	$(PY) benchmarks/figures.py --np $(NP) --out $(OUT)/figures $(if $(RESUME),--resume)
+	$(PY) benchmarks/reproduction/figures.py --np $(NP) --out $(OUT)/figures $(if $(RESUME),--resume)
 
 figures-quick: setup
-	$(PY) benchmarks/figures.py --quick --np $(NP) --out $(OUT)/figures-quick $(if $(RESUME),--resume)
+	$(PY) benchmarks/reproduction/figures.py --quick --np $(NP) --out $(OUT)/figures-quick $(if $(RESUME),--resume)
 
 # $(OUT)/report/: REPORT.html with its images, REPORT.md and REPORT.pdf (headless Chromium), one
 # folder that still works when moved or zipped.
 report: setup
-	$(PY) benchmarks/report.py --results $(OUT) --pdf
+	$(PY) benchmarks/reproduction/report.py --results $(OUT) --pdf
 
 # Platforms (root, debootstrap; roots cached in /var/cache/damage-dolfinx/roots, rebuilt when
 # missing): the README's two commands in a bare Debian 12 minbase root (AS_USER=1: as a non-root
@@ -108,8 +108,8 @@ cross-version:
 # per problem; arrays and time steps compared with the runs' own files, one frame rendered each.
 check-paraview: setup
 	@command -v pvpython >/dev/null && command -v xvfb-run >/dev/null || $(APT) install -y python3-paraview xvfb xauth
-	$(PY) benchmarks/cross_version.py run --out $(OUT)/paraview-runs
-	$(PY) benchmarks/paraview_check.py $$(ls -d $(OUT)/paraview-runs/*/) --out $(OUT)/paraview-check
+	$(PY) benchmarks/platforms/cross_version.py run --out $(OUT)/paraview-runs
+	$(PY) benchmarks/platforms/paraview_check.py $$(ls -d $(OUT)/paraview-runs/*/) --out $(OUT)/paraview-check
 
 clean:
 	rm -rf $(VENV) results .pytest_cache build *.egg-info docs/_generated docs/demos

@@ -40,7 +40,7 @@ def _parser():
                         help="Section 2.4: Tresca (P1) or simplified Coulomb (P2) "
                              "(same as --set friction_law=...)")
         sp.add_argument("--reading", choices=("literal", "evidence"),
-                        help="thesis data read literally or as the evidence reading (issue 16; "
+                        help="thesis data read literally or as the evidence reading ("
                              "default: the example's default_reading, see `list`)")
 
     run = sub.add_parser("run", help="run one example", allow_abbrev=False)

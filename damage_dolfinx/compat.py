@@ -86,7 +86,7 @@ def tensor_dg0(msh):
 
 def facet_vertex_quadrature() -> dict:
     """Integration metadata of the vertex rule on the triangular facets of a tetrahedral mesh
-    (nodal quadrature of a 3-D boundary integral, issue 17). FFCx 0.9+ applies its "vertex"
+    (nodal quadrature of a 3-D boundary integral). FFCx 0.9+ applies its "vertex"
     scheme to the facet; FFCx 0.5 applies it to the cell (tetrahedron points on a facet) and
     Basix has no GLL rule on triangles, so there the rule is given explicitly: weight 1/6 (a
     third of the reference triangle's area) at each vertex."""
@@ -122,7 +122,7 @@ def assemble_vector(b, L_form):
 def assemble_vector_array(b: np.ndarray, L_form):
     """Add the assembled L_form into the array ``b`` (local entries, ghosts included, no ghost
     update): the ndarray path of fem.assemble_vector in 0.5-0.11, without the PETSc local
-    form of assemble_vector (issue 18: a few microseconds a call on small meshes)."""
+    form of assemble_vector (a few microseconds a call on small meshes)."""
     fem.assemble_vector(b, L_form)
 
 

@@ -101,7 +101,7 @@ EXTRA_RULES = {
     "memory_mode": (lambda v: v in ("auto", "running", "recursive", "sum"),
                     "must be one of auto, running, recursive, sum"),
     "damage_atol_rel": (lambda v: v >= 0, "(the obstacle step's absolute tolerance relative to "
-                        "||l||, issue 18) must be >= 0"),
+                        "||l||) must be >= 0"),
     "history_every": (lambda v: v >= 1 and v == int(v),
                       "(a history.csv row every that many steps) must be a whole number >= 1"),
     "stability_check": (lambda v: v in ("warn", "error", "off"),

@@ -1,6 +1,6 @@
 """Structured box (x0, x1) x (y0, y1) x (z0, z1) with n_x x n_y x n_z hexahedra, each cut into 6
 tetrahedra (DOLFINx ``create_box``), boundary parts tagged by markers on the facet vertices: the
-3-D counterpart of ``rectangle`` for the contact examples of issue 17 (2.3, 3.1, 3.3 on a box,
+3-D counterpart of ``rectangle`` for the 3-D contact examples (2.3, 3.1, 3.3 on a box,
 normal compliance on a plane face). Meshes with n and 2n are nested.
 """
 import math

@@ -1,4 +1,4 @@
-"""Box (0, side)^2 x (0, height) with a clamped box-shaped hole, structured tetrahedra (issue 17).
+"""Box (0, side)^2 x (0, height) with a clamped box-shaped hole, structured tetrahedra.
 
 The 3-D counterpart of ``square_with_hole`` (Section 2.1 Example 1): an n x n x n_z grid of
 hexahedra, each cut into the 6 tetrahedra of DOLFINx's ``create_box``, without the hexahedra of

@@ -1,6 +1,6 @@
 """The ring wrench of Section 3.3 Example 3 (thesis Figure 3.19) as a plate with thickness: the
 2-D outline of ``wrench.py`` (head disc R = 1.2 with a hexagonal hole across flats 1.0,
-handle [1, 10] x [-0.4, 0.4], rotated by -45 degrees) extruded along z by ``thickness`` (issue 17).
+handle [1, 10] x [-0.4, 0.4], rotated by -45 degrees) extruded along z by ``thickness``.
 
 Thickness 0.4 by default: half the handle width, about the proportion of a real box-end wrench
 (a 13 mm wrench, the unit here being the across-flats size of the screw, is about 5-6 mm thick

@@ -3,7 +3,7 @@ run's ``fields.xdmf`` the way a user does in ParaView (its XDMF reader) and writ
 sees: the time steps and, at the last one, every grid of the file (DOLFINx writes one temporal
 grid per function: u, zeta, von Mises ...) with its point coordinates and point arrays, and its
 cell centres and cell arrays, as JSON. It renders the last frame (zeta) to a PNG.
-``benchmarks/paraview_check.py`` compares the JSON with the run's own history.csv and
+``benchmarks/platforms/paraview_check.py`` compares the JSON with the run's own history.csv and
 fields_final.npz. Nothing here imports damage_dolfinx: ParaView's Python is another interpreter."""
 import json
 import sys

@@ -1,4 +1,4 @@
-"""Issue 17, 3-D: constitutive pieces against numpy, the 2-D results unchanged (against runs
+"""3-D: constitutive pieces against numpy, the 2-D results unchanged (against runs
 recorded before any 3-D change), and physics checks of the 3-D Section 2.1 model. Small meshes:
 every test takes seconds."""
 import json
@@ -119,15 +119,15 @@ def test_von_mises_3x3(cube):
 
 
 def test_2d_runs_unchanged(tmp_path):
-    """The fixed small 2-D runs of benchmarks/threed_2d_reference.py, one or more per problem
+    """The fixed small 2-D runs of tests/reference_2d.py, one or more per problem
     (2.1-ex1, 2.2-ex1, 2.2-ex3, 2.3-ex1, 2.4-ex1, 3.1-ex2, 3.2-ex1, 3.3-ex2), equal the runs
     recorded at 0c50637 (tests/data/reference_2d.json; 2.1-ex1 and 2.2-ex1 there equal the
-    first recording, 549c1d6, before any issue-17 change) to round-off: every history column at
+    first recording, 549c1d6, before any 3-D change) to round-off: every history column at
     every step and every final nodal field. On another DOLFINx version than the recording's
     (0.5.2) the location columns of extreme values are not compared: ties there are broken by
     the dof order, which 0.11 changes (measured: zeta_min_x of 2.4-ex1 moves to a tied vertex)."""
-    sys.path.insert(0, str(HERE.parent / "benchmarks"))
-    from threed_2d_reference import CASES, REFERENCE, compare, run_case, same_version
+    sys.path.insert(0, str(HERE))
+    from reference_2d import CASES, REFERENCE, compare, run_case, same_version
     ref = json.loads(REFERENCE.read_text())
     for ex, args in CASES.items():
         diffs = compare(run_case(ex, args, tmp_path / ex), ref["runs"][ex], same_version(ref))

@@ -1,4 +1,4 @@
-"""geometries/box_with_hole.py builds the box minus the hole directly (issue 17, scaling): the
+"""geometries/box_with_hole.py builds the box minus the hole directly (scaling): the
 same tetrahedra as DOLFINx's create_box without the cells inside the hole, the expected facet
 tags, serially and on 2 ranks. Small meshes: about a second."""
 import subprocess

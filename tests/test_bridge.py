@@ -1,6 +1,6 @@
-"""Section 2.1 Example 3 (masonry arch bridge, GitHub issue 3): geometry, loads, the collapse
+"""Section 2.1 Example 3 (masonry arch bridge): geometry, loads, the collapse
 criterion checked against the saved fields, and serial = mpirun -n 2. Coarse meshes; the thesis-
-size run and the sensitivity study live in benchmarks/bridge_*.py."""
+size run and the sensitivity study live in benchmarks/studies/bridge_*.py."""
 import csv
 import json
 import math
@@ -134,7 +134,7 @@ def test_collapse_detection_matches_saved_fields(tmp_path):
     # ... and it was not met one step earlier
     assert float(last["weakest_section_zeta_max"]) <= 0.01 + 1e-9
     assert all(float(r["weakest_section_zeta_max"]) > 0.01 + 1e-9 for r in rows[:-1])
-    # issue 16: the damage stays in [zeta_star, 1] at every step (obstacle step, damage_bound)
+    # The damage stays in [zeta_star, 1] at every step (obstacle step, damage_bound)
     assert summary["damage_bound"] == "obstacle"
     assert summary["zeta_min_run"] >= 0.01 - 1e-10
     assert min(float(r["zeta_min"]) for r in rows) >= 0.01 - 1e-10
@@ -168,7 +168,7 @@ def test_literal_linear_step_leaves_the_admissible_set(tmp_path):
     """--reading literal (= --set damage_bound=none) keeps the linear step (2.20): with the thesis
     data the source violates (2.11) and zeta_n falls far below zeta_star (-554 on this mesh),
     which is why the default (evidence) solves the step as the obstacle problem over
-    [zeta_star, 1] (issue 16)."""
+    [zeta_star, 1]."""
     run_cli(COARSE + ["--reading", "literal", "--out", tmp_path])
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["damage_bound"] == "none" and summary["status"] == "collapse"

@@ -1,4 +1,4 @@
-"""Cell-wise stress maps (issue 18, cellwise_stress.py): equal to the interpolation they replace
+"""Cell-wise stress maps (cellwise_stress.py): equal to the interpolation they replace
 on random states, truncation included, in 2-D and 3-D; a map that differs is refused."""
 import numpy as np
 import pytest

@@ -1,4 +1,4 @@
-"""Issue 17, 3-D contact: normal compliance on a plane face against its closed form, the 3-D
+"""3-D contact: normal compliance on a plane face against its closed form, the 3-D
 contact monitor, the wrench plate's facet tags against the outline times the thickness, and
 serial = 2 ranks for the 3-D contact examples (2.3-ex1-3d, 3.1-ex1-3d, 3.3-ex1-3d, 3.3-ex3-3d)
 at tiny meshes. Every test takes seconds."""

@@ -1,4 +1,4 @@
-"""Faults a run survives (issue 20; the full table: benchmarks/faults.py): restarts of finished
+"""Faults a run survives (the full table: benchmarks/faults/faults.py): restarts of finished
 runs, corrupted checkpoints, a full disk (here a file-size limit, no root needed), signals, a
 double run. Every fault ends with one line and a documented exit status, nothing finished is
 lost, and resumed runs equal the uninterrupted run to 1e-12."""

@@ -1,4 +1,4 @@
-"""Figure style rules (issue 19): damage colour bars never autoscaled, amplification factors
+"""Figure style rules: damage colour bars never autoscaled, amplification factors
 round, one stress scale within a thesis pair, and the fidelity comparison of the thesis tables."""
 import json
 import math
@@ -73,10 +73,10 @@ def test_pair_shares_the_stress_scale(tmp_path):
 
 
 def test_fidelity_reads_the_tables_and_our_studies(tmp_path):
-    sys.path.insert(0, str(REPO / "benchmarks"))
+    sys.path.insert(0, str(REPO / "benchmarks" / "reproduction"))
     import fidelity
-    shared = json.loads(fidelity.thesis_tables()[1].read_text())
-    assert shared == json.loads(fidelity.LOCAL_TABLES.read_text())  # the copy is verbatim
+    assert fidelity.thesis_tables()[1] == REPO / "benchmarks" / "thesis_tables.json"  # ours only
+    shared = json.loads(fidelity.LOCAL_TABLES.read_text())
     result = fidelity.compare(tmp_path)  # no results folder: the committed studies
     tables = {t["table"]: t for t in result["tables"]}
     assert set(tables) == {"2.4", "2.5", "2.6", "2.7", "3.1", "3.2"}
@@ -143,9 +143,9 @@ def test_convergence_error_label_in_mathtext():
 
 def test_every_plot_goes_through_figstyle():
     """No module draws with matplotlib directly: figure sizes, fonts, mathtext, colour scales and
-    layout come from figstyle (issue 19)."""
+    layout come from figstyle."""
     import re
-    files = list((REPO / "damage_dolfinx").rglob("*.py")) + list((REPO / "benchmarks").glob("*.py"))
+    files = list((REPO / "damage_dolfinx").rglob("*.py")) + list((REPO / "benchmarks").rglob("*.py"))
     direct = [p.name for p in files if p.name != "figstyle.py" and
               re.search(r"^\s*(import matplotlib|from matplotlib)|\.savefig\(|plt\.subplots",
                         p.read_text(), re.M)]

@@ -208,7 +208,7 @@ def test_bad_elastic_term_is_refused(tmp_path):
 
 
 def test_fast_velocity_matrix_equals_reassembly():
-    """Issue 18: the matrix of (3.159) updated from the nodal zeta_n by the precomputed sparse
+    """The matrix of (3.159) updated from the nodal zeta_n by the precomputed sparse
     map equals the re-assembled one to round-off, Dirichlet rows included, for any zeta in K^h;
     an unchanged zeta leaves the matrix untouched."""
     from damage_dolfinx.numerics.zeta_linear import VelocitySolver
@@ -233,7 +233,7 @@ def test_fast_velocity_matrix_equals_reassembly():
 
 
 def test_fast_velocity_rhs_equals_assembly():
-    """Issue 18, Phi_L = identity (L_trunc = inf, the wrench): the right-hand side of (3.159)
+    """Phi_L = identity (L_trunc = inf, the wrench): the right-hand side of (3.159)
     as rho/k M v_{n-1} - K_B(zeta_{n-1}) u_{n-1} + assembled contact and load equals the
     assembled l to round-off, with the contact term active."""
     from damage_dolfinx.numerics.solvers import LinearSolver
@@ -266,7 +266,7 @@ def _rows(out):
 
 
 def test_history_cadence_and_restart(tmp_path):
-    """Issue 18: with --history-every 7 the rows are those of the run with a row per step at
+    """With --history-every 7 the rows are those of the run with a row per step at
     steps 0, 7, 14, ... and the last, every value equal; the maximal interpenetration over all
     steps (tracked between rows) and the final state are the same. A run stopped at step 15
     and continued with --restart ends with the same rows (plus its row at 15), fields and

@@ -1,5 +1,5 @@
 """Non-finite numbers and meshes that cannot fit are refused before any work: one line on
-stderr, exit status 2, no traceback, nothing written (issue 15)."""
+stderr, exit status 2, no traceback, nothing written."""
 import pytest
 
 from conftest import run_cli

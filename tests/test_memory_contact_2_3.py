@@ -104,7 +104,7 @@ def test_example3_fading_memory_and_residual_stress(tmp_path):
 
 
 def test_split_jacobian_equals_assembly():
-    """The 2.3 Jacobian split (issue 18: constant cell part once, Gamma_C term per Newton step)
+    """The 2.3 Jacobian split (constant cell part once, Gamma_C term per Newton step)
     equals the full assembly, Dirichlet rows included, at a state in contact on part of Gamma_C;
     a residual whose cell part depends on u is not split."""
     import ufl

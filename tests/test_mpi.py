@@ -43,7 +43,7 @@ def test_convergence_table_serial_equals_two_ranks(tmp_path):
 @pytest.mark.mpi
 def test_convergence_reference_on_one_rank(tmp_path):
     """The layout with the reference serially on rank 0 and the cells on the other ranks
-    (--reference-ranks 1, issue 18) gives the table of the serial study, on 2 and 3 ranks; the
+    (--reference-ranks 1) gives the table of the serial study, on 2 and 3 ranks; the
     3.3 reference uses the serial-only zeta-linear matrices there."""
     args = ["converge", "3.3-ex1", "--ref-n", "16", "--ref-k", "0.002", "--n", "4", "8",
             "--k", "0.01", "0.004", "--T", "0.1", "--quiet"]

@@ -1,4 +1,4 @@
-"""Readings of the thesis data (issue 16): literal = stated data, evidence = documented departures.
+"""Readings of the thesis data: literal = stated data, evidence = documented departures.
 
 Catalogue-level checks (no solve): every departure is an R-entry of the assumptions with thesis
 line numbers, the literal reading is the catalogue entry itself, and the reading is selectable

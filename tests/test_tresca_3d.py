@@ -1,4 +1,4 @@
-"""3-D Tresca friction with a 2-D tangent plane (issue 17): a block sliding or sticking on its
+"""3-D Tresca friction with a 2-D tangent plane: a block sliding or sticking on its
 bottom face under a uniform shear whose direction d = (3, 4, 0)/5 has both tangential components
 matches the closed-form simple shear for the four solvers (regularised Newton, the primal-dual
 active set, Uzawa, penalty-duality); the same on 2 ranks; non-plane contact faces are refused."""

@@ -1,7 +1,7 @@
-"""The masonry barrel vault in 3-D (issue 17, 2.1-ex3-vault): gmsh geometry (counts of the
+"""The masonry barrel vault in 3-D (2.1-ex3-vault): gmsh geometry (counts of the
 structured grid, tag areas), equilibrium of the line load across the width, the width-averaged
 section rotation, a coarse run that collapses with its hinge lines re-derived from the saved
-fields, and serial = 2 ranks. Coarse meshes (h = 0.2); the study is benchmarks/vault_3d.py."""
+fields, and serial = 2 ranks. Coarse meshes (h = 0.2); the study is benchmarks/studies/vault_3d.py."""
 import json
 import math
 
@@ -115,7 +115,7 @@ def run_coarse(out, monkeypatch=None, np_=1):
         from damage_dolfinx.catalogue import bridge
         monkeypatch.setattr(bridge, "VAULT_GEOMETRY", dict(COARSE))
         return runner.run("2.1-ex3-vault", out, h=H, progress=False, figures=False)
-    code = ("import sys; from damage_dolfinx import runner; from damage_dolfinx.catalogue import "
+    code = ("import sys; from damage_dolfinx.runtime import runner; from damage_dolfinx.catalogue import "
             f"bridge; bridge.VAULT_GEOMETRY.update({COARSE!r}); runner.run('2.1-ex3-vault', "
             f"sys.argv[1], h={H}, progress=False, figures=False)")
     import subprocess

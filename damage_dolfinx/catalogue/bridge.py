@@ -1,11 +1,11 @@
-"""Catalogue entry of thesis Section 2.1 Example 3: masonry arch bridge collapse (GitHub issue 3).
+"""Catalogue entry of thesis Section 2.1 Example 3: masonry arch bridge collapse.
 
 Data from the thesis: E = 5 GPa, nu = 0.49, density 2200 kg/m^3, k = 0.001 s, kappa = 1e-2,
 zeta_star = 0.01, lam_D = 2e-3, lam_u = 5e9, lam_w = 7e-4; mesh of 8400 P1 triangles and 4515
 nodes. Everything else (geometry, supports, load history, q_star, the meaning of the single
 lam_u) is our default, listed in ``assumptions`` (docs/models.md, section 2.1-collapse).
 
-Readings (issue 16): ``literal`` keeps the linear damage step (2.20), whose zeta leaves
+Readings: ``literal`` keeps the linear damage step (2.20), whose zeta leaves
 [zeta_star, 1]; ``evidence`` (the default) solves it as the obstacle problem over [zeta_star, 1]
 (the first departure of EVIDENCE). ``--set damage_bound=none|obstacle|clamp`` selects the step
 directly.
@@ -23,14 +23,14 @@ from damage_dolfinx import ModelParameters
 #: rate: the model's default 1000 kN/s gives 30 kN, the thesis's load increment of 0.02 kN per step
 #: (line 1127, stated for the contact model) gives 0.72 kN. 4500 kN/s (4.5 kN per step) is the
 #: smallest multiple of 250 kN/s whose failure load is >= the thesis's 90 kN: 94.5 kN (step 21);
-#: 4250 -> 89.25, 4000 -> 84, 5500 -> 104.5 kN (recalibrated with the bounded damage step, issue
-#: 16: same rate). It holds for the thesis's k = 0.001 only (k = 0.0005 -> 83.25 kN, 0.00025 ->
+#: 4250 -> 89.25, 4000 -> 84, 5500 -> 104.5 kN (recalibrated with the bounded damage step:
+#: same rate). It holds for the thesis's k = 0.001 only (k = 0.0005 -> 83.25 kN, 0.00025 ->
 #: 79.9 kN); the mesh matters less (h = 0.1 ... 0.025: 94.5, 94.5, 94.5, 90, 90 kN).
-#: benchmarks/bridge_sensitivity.py --calibrate reproduces it.
+#: benchmarks/studies/bridge_sensitivity.py --calibrate reproduces it.
 LOAD_RATE = 4500.0
 
 
-#: evidence reading (issue 16, benchmarks/README.md bridge section): the damage kept in [zeta*, 1]
+#: evidence reading (benchmarks/README.md, 'Examples with a thesis number'): the damage kept in [zeta*, 1]
 EVIDENCE = Reading(
     overrides={"damage_bound": "obstacle"},
     assumptions=[
@@ -119,10 +119,10 @@ def examples():
     return [ex3, vault_example(ex3)]
 
 
-#: the barrel vault (issue 17): width [m] and default element size [m]
+#: the barrel vault: width [m] and default element size [m]
 VAULT_WIDTH = 1.0
 VAULT_H = 0.1
-#: keyword arguments of barrel_vault besides h, read when the mesh is built (benchmarks/vault_3d.py
+#: keyword arguments of barrel_vault besides h, read when the mesh is built (benchmarks/studies/vault_3d.py
 #: sets other widths and plane-strain ends here; the catalogue entry is W = 1 m, free ends)
 VAULT_GEOMETRY = {"width": VAULT_WIDTH}
 
@@ -139,7 +139,7 @@ def vault_example(ex3):
               "P = load_rate t [kN/m] across the width at quarter span: collapse load, hinge lines",
         make_geometry=lambda comm, n, h: barrel_vault(comm, h=h, **VAULT_GEOMETRY),
         assumptions=[
-            "issue 17 (beyond the thesis, which is plane stress): the ring of 2.1-ex3 (G3 "
+            "beyond the thesis (which is plane stress): the ring of 2.1-ex3 (G3 "
             f"geometry, no fill) extruded along z by W = {VAULT_WIDTH:g} m; free end faces "
             "(a free-standing vault); springing faces clamped over the whole width",
             f"structured n_r x n_theta x n_W = round(0.7/h) x round(15/h) x round(W/h) grid, 3 "
@@ -164,7 +164,7 @@ def vault_example(ex3):
             "collapse, problems/bridge_2_1.py), damage obstacle step SNES vinewtonrsls",
             "discretisation: linear tetrahedra lock at nu = 0.49: a thin vault is 17 % too stiff "
             "at h = 0.1 (7 % at 0.05), so the failure load at h = 0.1 is a coarse-mesh value "
-            "(benchmarks/README.md, '3-D: the barrel vault'; at h = 0.05 a 0.1 m wide vault "
+            "(benchmarks/reference_output/vault_3d/vault_3d.md; at h = 0.05 a 0.1 m wide vault "
             "fails at the 2-D arch's 94.5 kN/m)",
         ],
         figures=[Figure("vault_slices.png", "2.1-ex3-vault at collapse: section z = W/2 (the "

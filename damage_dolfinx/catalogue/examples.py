@@ -4,7 +4,7 @@ Every value the thesis leaves open is an explicit assumption, listed in the exam
 ``assumptions`` and copied into each run's summary.json; docs/models.md gives the reasons, model
 by model.
 
-Readings (``--reading literal|evidence``, issue 16): ``literal`` is exactly the stated thesis
+Readings (``--reading literal|evidence``): ``literal`` is exactly the stated thesis
 data (the catalogue entry itself); ``evidence`` replaces some of it by the values that reproduce
 the thesis results with the fewest departures from the text (:class:`Reading`, each departure an
 assumption with its thesis lines and the measured evidence). An example without an evidence
@@ -67,7 +67,7 @@ class Example:
     diameter: float
     n: Optional[int] = None          # structured meshes: cells per side
     h: Optional[float] = None        # gmsh meshes: element size
-    dim: int = 2                     # space dimension of the mesh (3: the issue-17 examples)
+    dim: int = 2                     # space dimension of the mesh (3: the 3-D examples)
     body_force: Optional[Callable] = None
     traction: Optional[Callable] = None
     zeta0: object = 1.0

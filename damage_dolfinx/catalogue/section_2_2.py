@@ -26,7 +26,7 @@ def _params(g_fric, solver="newton"):
                "rho_uzawa": RHO_UZAWA, "omega_pd": OMEGA_PD, "friction_tol": 1e-6})
 
 
-#: evidence reading of Examples 1-2 (issue 16, benchmarks/readings.md)
+#: evidence reading of Examples 1-2 (benchmarks/readings.md)
 EVIDENCE = Reading(
     traction=lambda x, t: ufl.as_vector((100.0 * (ufl.exp(t) - 1.0), 0.0)),
     assumptions=[

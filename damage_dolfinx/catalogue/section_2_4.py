@@ -21,7 +21,7 @@ def _params(g_fric, law="tresca"):
                "friction_tol": 1e-6})
 
 
-#: evidence reading of Example 1 (issue 16, benchmarks/readings.md)
+#: evidence reading of Example 1 (benchmarks/readings.md)
 EVIDENCE_EX1 = Reading(
     traction=lambda x, t: ufl.as_vector((50.0 * (ufl.exp(t) - 1.0), 0.0)),
     overrides={"stress_in_error": "no"},

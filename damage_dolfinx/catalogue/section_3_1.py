@@ -36,7 +36,7 @@ def zeta0_example2(x):
     return 0.1 + 0.9 * np.minimum(1.0, np.maximum(0.0, np.abs(x[0] - 1.5) - 0.2) / 1.3)
 
 
-#: evidence reading of Example 1 (issue 16, benchmarks/readings.md)
+#: evidence reading of Example 1 (benchmarks/readings.md)
 EVIDENCE_EX1 = Reading(
     overrides={"c_nu": 5e-5, "error_norm": "velocity_only"},
     assumptions=[
@@ -141,9 +141,9 @@ def examples():
             "springs (rho = 0.05, c_nu = 2e5: omega^2 ~ c_nu/(rho H) ~ 4e6); at k = 0.01 the "
             "contact chatters and the overhang lifts off; --k 0.01 runs the thesis value (warning)",
             "two runs: damage_active = 1 (default) and 0 (zeta frozen at zeta_0 = 1, step (1) "
-            "skipped); benchmarks/lshape_3_1.py runs both and compares max |u|",
+            "skipped); benchmarks/studies/lshape_3_1.py runs both and compares max |u|",
             "Figure 3.8: von Mises norm of eps(u_n) (field von_mises_strain, DG0); "
-            "benchmarks/lshape_3_1.py draws both runs side by side"],
+            "benchmarks/studies/lshape_3_1.py draws both runs side by side"],
         figures=[Figure("figure_3_6.png", "Example 3.1-3: setting and mesh", kind="mesh"),
                  Figure("figure_3_7.png", "Example 3.1-3: deformed mesh and initial outline",
                         fields=("zeta",), amplification=10.0, mesh_lines=True),

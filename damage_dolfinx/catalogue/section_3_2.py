@@ -27,7 +27,7 @@ def _on(axis, value):
     return lambda X: np.isclose(X[axis], value, atol=1e-10)
 
 
-#: evidence reading of Example 1, the default (issue 16, benchmarks/readings.md)
+#: evidence reading of Example 1, the default (benchmarks/readings.md)
 EVIDENCE_EX1 = Reading(
     overrides={"kappa": 0.003, "lam_u": 2000.0},
     assumptions=[

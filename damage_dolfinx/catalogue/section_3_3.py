@@ -14,10 +14,10 @@ from damage_dolfinx import ModelParameters
 #: dividing T, from stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)
 K_EX2 = 6.25e-5
 #: Example 3: 0.8 k_max (k_max = 1.3662e-5 at h = 0.15) rounded down to a divisor of T = 6.5,
-#: 594 703 steps: the k of benchmarks/wrench_3_3.py and of its committed reference (issue 18:
+#: 594 703 steps: the k of benchmarks/studies/wrench_3_3.py and of its committed reference (
 #: the wrench keeps k = 0.8 k_max; it was 1e-5 = 0.73 k_max, 650 000 steps, until then)
 K_EX3 = 6.5 / 594_703
-#: issue 18: the wrench writes a history.csv row every 50 steps (5e-4 s at k = 1e-5; about
+#: The wrench writes a history.csv row every 50 steps (5e-4 s at k = 1e-5; about
 #: 13 000 rows for T = 6.5 instead of 650 000); the maximal interpenetration of summary.json is
 #: still tracked at every step (runner.py, ``--history-every`` / ``--set history_every=1``)
 HISTORY_EVERY_EX3 = 50
@@ -129,7 +129,7 @@ def examples():
             "to a divisor of 0.5 s; other n need their own k (n = 8: k_max = 1.8e-4; the run "
             "warns when k > k_max)",
             "G34: profiles of zeta along x2 = 3 (a) or x2 = 0 (b) every 0.5 s plus the last step "
-            "(summary.json 'profiles', drawn as figure_3_17_18.png; benchmarks/damage_limit_3_3.py "
+            "(summary.json 'profiles', drawn as figure_3_17_18.png; benchmarks/studies/damage_limit_3_3.py "
             "also picks k and reports the mending); "
             "zeta(0,6) vs t is the history column zeta_probe"],
         figures=[Figure("figure_3_17_18.png", "Example 3.3-2: damage profiles and damage at "
@@ -168,19 +168,19 @@ def examples():
             f"G33: k = {K_EX3:.6g} by default (T / 594 703, 0.8 k_max rounded down to a "
             "divisor of T = 6.5): k_max = 1.37e-5 at h = 0.15 (stability helper, omega_max^2 = "
             "2.5e10, inertia-limited by the h/3 = 0.05 elements at the hexagon); the k of "
-            "benchmarks/wrench_3_3.py (1e-5, 650 000 steps, before issue 18)",
+            "benchmarks/studies/wrench_3_3.py (1e-5, 650 000 steps)",
             "damage step: every increment is solved (damage_atol_rel = 0: the obstacle "
             "step's absolute tolerance is snes_atol = 1e-12, not 1e-9 ||l||, which kept zeta "
             "unchanged whenever the increment's residual was smaller: on the wrench the damage "
-            "of t < 0.3 and of many steps up to t = 1.4; issue 18)",
+            "of t < 0.3 and of many steps up to t = 1.4)",
             "damage right-hand side by sparse maps (damage_source_map: the source is constant "
             "on every cell for variant A with lam_D = 0 on P1; checked against the assembly "
-            "at set-up; issue 18)",
-            "history.csv: a row every history_every = 50 steps (issue 18); the maximal "
+            "at set-up)",
+            "history.csv: a row every history_every = 50 steps; the maximal "
             "interpenetration over all steps (summary.json max_penetration) is tracked at "
             "every step",
             "figures: x2 deformed mesh with the initial outline (Figure 3.20, edges over the "
-            "damage field; benchmarks/wrench_3_3.py also draws the bare wire mesh), von "
+            "damage field; benchmarks/studies/wrench_3_3.py also draws the bare wire mesh), von "
             "Mises (3.21) and damage (3.22) at T"],
         figures=[Figure("figure_3_19.png", "Example 3.3-3: setting and mesh", kind="mesh"),
                  Figure("figure_3_20.png", "Example 3.3-3: deformed configuration",

@@ -1,4 +1,4 @@
-"""3-D examples beyond the thesis (issue 17): the thesis models on 3-D meshes, same data.
+"""3-D examples beyond the thesis: the thesis models on 3-D meshes, same data.
 
 The thesis is 2-D plane stress (docs/models.md, "Common notation"); these entries keep each
 example's data and change only the body to a 3-D one, the elasticity to isotropic 3-D Hooke (whose
@@ -12,7 +12,7 @@ from damage_dolfinx.catalogue.examples import Example, Figure
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx import ModelParameters
 
-#: 3-D contact examples (issue 17, "3-D: contact" in benchmarks/README.md): default mesh sizes and
+#: 3-D contact examples (benchmarks/reference_output/contact_3d/): default mesh sizes and
 #: time steps; the k of the explicit dynamic schemes is at most 0.8 k_max of stability.py at the
 #: default mesh (measured, listed in each entry's assumptions)
 N_2_3_EX1, N_3_1_EX1, N_3_3_EX1 = 8, 12, 12
@@ -34,7 +34,7 @@ def _from_2d(ex2d, **changes):
     is out of reach)."""
     changes.setdefault("assumptions", [])
     changes["assumptions"] = (
-        [f"issue 17 (beyond the thesis): the 3-D counterpart of {ex2d.id} with its data; its "
+        [f"beyond the thesis: the 3-D counterpart of {ex2d.id} with its data; its "
          "2-D assumptions follow (marked '2-D:'), the geometry, mesh and time-step lines among "
          "them superseded by the 3-D lines after them"]
         + [f"2-D: {a}" for a in ex2d.assumptions] + changes["assumptions"])
@@ -67,7 +67,7 @@ def examples():
         model="2.1",
         body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t, 0.0)),
         assumptions=[
-            "issue 17 (beyond the thesis): the 3-D counterpart of 2.1-ex1 with its data "
+            "beyond the thesis: the 3-D counterpart of 2.1-ex1 with its data "
             "(E = 1e4, nu = 0.33, variant B, lam_D = 0.1, lam_u+ = 1000, lam_u- = 100, "
             "q_star = 1000, kappa = 1 (G1), zeta_star = 0.01, f_B = (50, 25, 0) t)",
             "3-D isotropic elasticity lambda tr(eps) I + 2 mu eps (its plane-stress reduction is "
@@ -186,7 +186,7 @@ def contact_examples():
             f"1.8/G33: k = {K_3_3_EX3:g}, at most 0.8 k_max of stability.py at the default mesh "
             "(k_max in summary.json)",
             f"final time T = {T_3_3_EX3:g} by default (the thesis' T = 6.5 is 650 000 explicit "
-            "steps: --T 6.5 runs it; benchmarks/README.md '3-D: contact' gives the measured "
+            "steps: --T 6.5 runs it; benchmarks/reference_output/contact_3d/examples.md gives the measured "
             "cost per step)",
             "solvers: as in 2-D (velocity CG + Jacobi with the fast matrix update in serial; "
             "damage obstacle step SNES vinewtonrsls, CG + Jacobi)"],

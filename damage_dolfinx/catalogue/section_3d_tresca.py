@@ -1,4 +1,4 @@
-"""3-D examples with Tresca friction (issue 17, "3-D: Tresca" in benchmarks/README.md): the
+"""3-D examples with Tresca friction: the
 Kelvin-Voigt examples of Sections 2.2 and 3.2 on a box, bilateral contact and Tresca friction on
 its bottom face with a 2-D tangent plane (friction/: Phi_eps(v_tau) = g v_tau / max(|v_tau|, eps)
 with v_tau a vector, two tangents per node).
@@ -53,7 +53,7 @@ def _from_2d(ex2d, reading_traction=None, **changes):
     """A 3-D entry with the data of ``ex2d`` (the literal entry: its parameters, time grid and
     readings; a reading's 2-D traction replaced by ``reading_traction``), no convergence
     study."""
-    assumptions = ([f"issue 17 (beyond the thesis): the 3-D counterpart of {ex2d.id} with its "
+    assumptions = ([f"beyond the thesis: the 3-D counterpart of {ex2d.id} with its "
                     "data; its 2-D assumptions follow (marked '2-D:'), the geometry, mesh and "
                     "solver lines among them superseded by the 3-D lines after them"]
                    + [f"2-D: {a}" for a in ex2d.assumptions] + _COMMON

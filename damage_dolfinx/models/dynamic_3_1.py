@@ -11,9 +11,9 @@ inclusion (variant A), scheme (3.48)-(3.51):
 V = {v = 0 on Gamma_D}; u_0 = v_0 = 0, zeta_0 from the example. The matrix of (2) does not change
 for a fixed k: it is factorised once (prefix ``mech_``), each step assembles a right-hand
 side. It is SPD (the Dirichlet rows are identity rows), so serially it is factorised by PETSc's
-own Cholesky (solvers.serial_cholesky; issue 18: 3.1-ex1 at n = 255, 131k dofs, velocity step
+own Cholesky (solvers.serial_cholesky; 3.1-ex1 at n = 255, 131k dofs, velocity step
 90 -> 41 ms; at n = 45, 4k dofs, 2.8 -> 1.3 ms) and by MUMPS LU in parallel. The dimension comes
-from the mesh (issue 17): on 3-D meshes with at least
+from the mesh: on 3-D meshes with at least
 ``VELOCITY_DIRECT_MAX_DOFS_3D`` unknowns the velocity system is solved by CG + GAMG with the
 rigid-body near-nullspace (AMG set up once, CG started from v_{n-1}) instead.
 Damage prefix ``damage_``. Parameters in ``extra``: rho, m_visc, c_nu, gap,
@@ -44,7 +44,7 @@ from damage_dolfinx.models.base import ProblemData, TimeStepper
 
 
 #: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
-#: scalable.py's rule; measured (benchmarks/README.md "3-D: contact"): for 100 steps the two break
+#: scalable.py's rule; measured (benchmarks/reference_output/contact_3d/crossover.md): for 100 steps the two break
 #: even at 6591 unknowns, the factorisation costs 55 s at 46 875 (GAMG ahead), its solves stay
 #: ~2x cheaper (long runs on mid-size meshes: -mech_ksp_type preonly -mech_pc_type lu)
 VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
@@ -68,7 +68,7 @@ class DynamicKelvinVoigt(TimeStepper):
         self.damage_active = bool(x.get("damage_active", True))
         # ||v||_H + ||zeta||_Y (Cor. 3.1; the thesis does not state its norm);
         # displacement: ||u||_V + ||zeta||_Y;
-        # velocity_only: ||v||_H (issue 16, the reading that reproduces Table 3.1's magnitude)
+        # velocity_only: ||v||_H (the reading that reproduces Table 3.1's magnitude)
         self.error_components = {
             "velocity": [("v", self.v, "L2"), ("zeta", self.zeta, "L2")],
             "displacement": [("u", self.u, "V"), ("zeta", self.zeta, "L2")],

@@ -57,7 +57,7 @@ class DynamicTresca(TimeStepper):
         # (1) damage obstacle step (3.94), explicit source. Its reduced systems are less
         # mass-dominated than in 3.3 (k kappa / h^2 = 0.5 at n = 128, k = 0.01, kappa = 0.003;
         # 164 with kappa = 1): CG preconditioned by incomplete Cholesky (block Jacobi per rank)
-        # instead of Jacobi, unless the user chose -damage_pc_type (issue 18: 24 -> 6 CG
+        # instead of Jacobi, unless the user chose -damage_pc_type (24 -> 6 CG
         # iterations per step; 444 -> 83 with kappa = 1, 129 -> 54 ms per damage step)
         self.damage = self.obstacle_damage_step()
         replace_default_option("damage_pc_type", "bjacobi")

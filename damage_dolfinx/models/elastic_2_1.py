@@ -65,7 +65,7 @@ class ElasticDamage(TimeStepper):
         a, L = equilibrium_forms(ufl.TrialFunction(V), w, self.zeta, p.E, p.nu, p.zeta_star,
                                  f_B, f_N, dsN)
         # Gamma_C, empty in every thesis example of 2.1, is read as bilateral contact u.nu = 0
-        # on coordinate-plane faces (rollers of the 3-D uniaxial-strain check, issue 17)
+        # on coordinate-plane faces (rollers of the 3-D uniaxial-strain check)
         bcs = [clamped(V, tags, GAMMA_D)] + bilateral_plane_faces(V, tags, GAMMA_C)
         # 2-D: lagged direct; 3-D: CG + AMG with the rigid-body near-nullspace (scalable.py)
         defaults, refactor_its = scalable.mech_config(V, lagged_direct(msh.comm),

@@ -59,12 +59,12 @@ from damage_dolfinx.models.base import ProblemData, TimeStepper
 MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
                  "ksp_max_it": 5000, "ksp_initial_guess_nonzero": True}
 
-#: issue 18 (per-step cost): the matrix of (3.159) from the nodal zeta_n by a precomputed sparse
+#: per-step cost: the matrix of (3.159) from the nodal zeta_n by a precomputed sparse
 #: map instead of a re-assembly (serial; equal to round-off); with Phi_L = identity the
 #: right-hand side too (FAST_RHS); CG started from the cubic extrapolation
 #: 4 v_{n-1} - 6 v_{n-2} + 4 v_{n-3} - v_{n-4} instead of v_{n-1} (same solution to rtol 1e-12;
-#: wrench, T = 0.05: 15.0 -> 9.1 iterations per step; linear 11.4, quadratic 10.1). Switches for
-#: benchmarks/step_profile_3_3.py, which times the step both ways.
+#: wrench, T = 0.05: 15.0 -> 9.1 iterations per step; linear 11.4, quadratic 10.1). Switches to time
+#: or check the step both ways.
 FAST_MATRIX = True
 FAST_RHS = True
 VELOCITY_EXTRAPOLATION = True
@@ -94,7 +94,7 @@ class FullyDamageableContact(TimeStepper):
         self.damage = None
         if self.damage_active:
             self.damage = self.obstacle_damage_step(damage_prefix)
-            # issue 18: ``damage_atol_rel`` (the wrench: 0) replaces the obstacle step's absolute
+            # ``damage_atol_rel`` (the wrench: 0) replaces the obstacle step's absolute
             # tolerance 1e-9 ||l|| (damage.OBSTACLE_ATOL_REL) by snes_atol = 1e-12 alone; with
             # 1e-9 ||l|| a step whose increment has a smaller residual keeps zeta_{n-1}, which
             # dropped the wrench's damage up to t = 0.3 and in many steps up to t = 1.4
@@ -103,7 +103,7 @@ class FullyDamageableContact(TimeStepper):
                 if not float(rel) >= 0.0:
                     raise InputError(f"damage_atol_rel must be >= 0, got {rel!r}")
                 self.damage.atol_rel = float(rel)
-            # issue 18: ``damage_source_map`` (the wrench): the damage right-hand side by sparse
+            # ``damage_source_map`` (the wrench): the damage right-hand side by sparse
             # maps where the source is constant on every cell (damage.use_cellwise_source; it
             # checks itself against the assembly and keeps the assembly otherwise)
             if x.get("damage_source_map"):
@@ -122,7 +122,7 @@ class FullyDamageableContact(TimeStepper):
         w = ufl.TestFunction(V)
         if self.elastic_term == "explicit":
             a, l = velocity_step_forms(ufl.TrialFunction(V), w, *args)
-            if self.comm.size == 1 and FAST_MATRIX:  # issue 18: no re-assembly per step
+            if self.comm.size == 1 and FAST_MATRIX:  # no re-assembly per step
                 parts = velocity_matrix_parts(ufl.TrialFunction(V), w, args[4], args[5], p.E,
                                               p.nu, self.m_visc)
                 rhs = None  # Phi_L = identity: l by the same sparse maps (clamped: g = 0)
@@ -169,7 +169,7 @@ class FullyDamageableContact(TimeStepper):
         return {}
 
     def _advance(self) -> dict:
-        if not hasattr(self, "_arrays"):  # views of the Functions' values (stable; issue 18)
+        if not hasattr(self, "_arrays"):  # views of the Functions' values (stable)
             self._arrays = [f.x.array for f in (self.u, self.u_old, self.v, self.v_old,
                                                 self.zeta, self.zeta_old, *self._v_older)]
         u, u_old, v, v_old, zeta, zeta_old, v3, v4 = self._arrays
@@ -262,7 +262,7 @@ class FullyDamageableContact(TimeStepper):
         """The base scalars (the same operations as TimeStepper.scalars, so the same values)
         plus v_L2, the interpenetration and the probe. The runner asks for them after every
         step (history.csv), so the vectors and views are cached and the extrema take one
-        Allreduce, none in serial (issue 18: 120 -> 40 us per wrench step)."""
+        Allreduce, none in serial (120 -> 40 us per wrench step)."""
         if not hasattr(self, "_scalar_cache"):
             self._norm_operators = self._assemble_norm_operators()
             owned = self.zeta.function_space.dofmap.index_map.size_local

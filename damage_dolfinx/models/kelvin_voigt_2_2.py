@@ -8,7 +8,7 @@ by the obstacle inclusion (variant A), scheme (2.66)-(2.68):
     (3) u_n = u_{n-1} + k v_n                                                   (2.68)
 
 V = {v = 0 on Gamma_D, v.nu = 0 on Gamma_C}; j(w) = int_{Gamma_C} g |w_tau| (nodal quadrature).
-The dimension comes from the mesh: in 3-D (issue 17) B is isotropic 3-D elasticity, w_tau a
+The dimension comes from the mesh: in 3-D B is isotropic 3-D elasticity, w_tau a
 vector of the tangent plane of Gamma_C (faces parallel to coordinate planes).
 Step (2) by one of the three friction solvers (damage_dolfinx/numerics/friction/), chosen by the parameter
 ``friction_solver`` (newton | uzawa | penalty-duality). Prefixes: ``damage_``, ``friction_``

@@ -7,7 +7,7 @@ and damage (PDE form, variant A), scheme (2.136)-(2.137).
           (B eps(u_n) + M_n, eps(w)) + (p_nu(u_n.nu - gap), w.nu)_{Gamma_C} = L_n(w)         (2.137)
 
 p_nu(r) = c_nu r_+ (semismooth Newton, SNES prefix ``mech_``); damage PDE step prefix
-``damage_`` (matrix factorised once). The dimension comes from the mesh (issue 17): on a 3-D mesh
+``damage_`` (matrix factorised once). The dimension comes from the mesh: on a 3-D mesh
 B is 3-D Hooke, M_n a 3x3 tensor, Gamma_C any plane or curved face; from
 ``scalable.DIRECT_MAX_DOFS_3D`` unknowns on, Newton's linear systems are solved by CG +
 BoomerAMG (``mech_contact_amg``; the AMG set-up lagged like the factorisation in 2-D) and
@@ -47,8 +47,7 @@ def mech_contact_amg():
     scalable.py, fails here: with the near-rigid foundation (c_nu = 1e10 against E = 100) its
     Chebyshev/Jacobi smoother gave an indefinite preconditioner once the contact term was active
     (2.3-ex1-3d, n = 10 and 20), with SOR smoothing a failed level solve at n = 20; BoomerAMG
-    took 8-14 CG iterations per Newton step at n = 10 and 20 (benchmarks/README.md "3-D:
-    contact")."""
+    took 8-14 CG iterations per Newton step at n = 10 and 20."""
     return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
 
 
@@ -81,7 +80,7 @@ class ViscoelasticMemoryContact(TimeStepper):
         self.memory = MemoryTerm(msh, kernel, k, x.get("memory_mode", "auto"))
         self._g_expr = compat.expression(
             memory_integrand(self.u, self.zeta, p.E, p.nu, p.L_trunc), self.memory.space)
-        # issue 18: g by the cell stress map S u (cellwise_stress.py, checked against the
+        # g by the cell stress map S u (cellwise_stress.py, checked against the
         # interpolation at construction; P1 u on simplices): 0.9 ms of 3.8 per step at 4k dofs
         self._g_map = None
         if compat.element_degree(V) == 1:
@@ -110,7 +109,7 @@ class ViscoelasticMemoryContact(TimeStepper):
                 A.setNearNullSpace(modes)
         else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation; the Jacobian
             # is the constant (B eps(du), eps(w)) plus the Gamma_C term, which alone is
-            # assembled per Newton step (issue 18: 2.3-ex1 at n = 160, 31 ms of 99 per step)
+            # assembled per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per step)
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
                                         refactor_after_its=MECH_REFACTOR_ITS,
                                         jacobian_split=constant_cell_jacobian(F, self.u))

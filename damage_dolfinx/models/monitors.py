@@ -52,7 +52,7 @@ class ContactMonitor:
         self.normal = np.where(outward[:, None], n, -n)
         self.present = self.comm.allreduce(int(facets.size), op=MPI.SUM) > 0
         self.d = d
-        # (u.nu - gap) at the facet vertices, facet by facet, from flat views (issue 18: the
+        # (u.nu - gap) at the facet vertices, facet by facet, from flat views (the
         # per-step track() costs a few NumPy operations on the Gamma_C dofs)
         flat = self.dofs.reshape(-1)
         self._index = [flat * d + c for c in range(d)]

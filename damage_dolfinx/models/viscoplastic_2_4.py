@@ -61,7 +61,7 @@ class ElastoViscoplasticFriction(TimeStepper):
             viscoplastic_rate(self.sigma_old, self.zeta_old, p.L_trunc, x["viscoplastic_sign"]), Q)
         self._sigma_expr = compat.expression(
             stress_update(self.sigma_old, self.w, self.G_hat, k, p.E, p.nu), Q)
-        # issue 18: (3) by the cell stress map S w (cellwise_stress.py, checked against the
+        # (3) by the cell stress map S w (cellwise_stress.py, checked against the
         # interpolation at construction): 0.5 ms of 3.4 per step at 4k dofs
         try:
             self._stress_map = StressUpdate(self.sigma, self.sigma_old, self.w, self.G_hat,
@@ -94,7 +94,7 @@ class ElastoViscoplasticFriction(TimeStepper):
         self.output_fields = [self.u, self.zeta, self.von_mises, self.sigma]
         self.error_components = [("u", self.u, "V"), ("sigma", self.sigma, "L2"),
                                  ("zeta", self.zeta, "L2")]  # e_hk of Section 2.4.3
-        if x.get("stress_in_error", "yes") == "no":  # issue 16: e_hk without ||sigma||_Q
+        if x.get("stress_in_error", "yes") == "no":  # e_hk without ||sigma||_Q
             self.error_components = [c for c in self.error_components if c[0] != "sigma"]
         self.timings = {"damage": 0.0, "friction": 0.0, "stress": 0.0}
 
@@ -135,7 +135,7 @@ class ElastoViscoplasticFriction(TimeStepper):
         out = super().scalars()
         out["zeta_min_x"], out["zeta_min_y"] = self._most_damaged_point()
         out["stress_Q"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
-        if self.mesh.topology.dim == 3:  # |u_tau| at the contact nodes (3-D, issue 17)
+        if self.mesh.topology.dim == 3:  # |u_tau| at the contact nodes (3-D)
             u1 = law.norm(self.friction.nodes.tangential(self.u))
         else:
             u1 = self.u.x.array.reshape(-1, 2)[self._contact_dofs, 0]  # Gamma_C is horizontal here

@@ -1,8 +1,7 @@
 """UFL residual and Jacobian callbacks for the SNES of solvers.py: the plain assembly
 (:func:`form_callbacks`, the pattern of fenicsx-patterns section 2) and the split Jacobian of a
 residual whose domain part is linear with fixed coefficients (:func:`constant_cell_jacobian`:
-the constant part assembled once, the rest, e.g. a Gamma_C contact term, per Newton step;
-issue 18)."""
+the constant part assembled once, the rest, e.g. a Gamma_C contact term, per Newton step)."""
 from __future__ import annotations
 
 import numpy as np
@@ -19,7 +18,7 @@ def form_callbacks(F, J, u, bcs, jacobian_split=None):
     ``jacobian_split`` = (J_constant, J_varying) with J = J_constant + J_varying, J_constant
     independent of u and of time (no Function in it): J_constant is assembled once (with the
     Dirichlet identity rows), each Jacobian is a copy of it plus an assembly of J_varying
-    alone (issue 18: 2.3's normal compliance, a Gamma_C integral, instead of the whole domain).
+    alone (2.3's normal compliance, a Gamma_C integral, instead of the whole domain).
     """
     F_form, J_form = compat.form(F), compat.form(J)
     u_vec = compat.petsc_vec(u)

@@ -1,4 +1,4 @@
-"""The damage right-hand side by sparse maps when the source is constant on every cell (issue 18).
+"""The damage right-hand side by sparse maps when the source is constant on every cell.
 
 l(xi) = (zeta_old, xi) + k (phi_old, xi) is assembled every step of the damage step (damage.py).
 With variant A and lam_D = 0 (all of Section 3.3) the source is phi = -0.5 lam_u Psi_q(eps(u_old))
@@ -87,7 +87,7 @@ class CellwiseSource:
         self.G.mult(self.u, self.e)
         e, phi = self._e, self._phi
         np.multiply(e, e, out=self._e_sq)  # |eps_c|^2: squares summed by a BLAS product
-        np.dot(self._e_sq, self._ones, out=phi)  # (14 -> 7 us on the wrench; issue 18)
+        np.dot(self._e_sq, self._ones, out=phi)  # (14 -> 7 us on the wrench)
         np.minimum(phi, p.q_star, out=phi)
         phi *= -0.5 * p.lam_u
         phi -= p.lam_w

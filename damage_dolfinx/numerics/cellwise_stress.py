@@ -1,4 +1,4 @@
-"""Cell-wise stresses by a sparse map instead of an interpolated fem.Expression (issue 18).
+"""Cell-wise stresses by a sparse map instead of an interpolated fem.Expression.
 
 For P1 displacements on simplices eps(u) is constant on each cell, so is B eps(u): the map
 u -> (B eps(u))_c is a sparse matrix S, assembled once as (B eps(u), tau) over the DG0 tensor

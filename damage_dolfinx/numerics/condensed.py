@@ -1,5 +1,5 @@
 """Direct solves with J = A + diag(K) for a constant SPD matrix A and a diagonal K that lives on
-a few rows C and changes from solve to solve (issue 18).
+a few rows C and changes from solve to solve.
 
 The friction Jacobians of friction/ have this form: A is the constant matrix of the velocity
 (or increment) step and K sits on the tangential dofs of the contact nodes (nodal quadrature,
@@ -22,7 +22,7 @@ stays (one triangular solve per solve, as before). Both paths are exact direct s
 differ by round-off. The condensation is built lazily, at the first solve with a K other than
 the factorised one.
 
-3-D friction (issue 17) has 2x2 blocks per contact node instead of a diagonal: the condensation
+3-D friction has 2x2 blocks per contact node instead of a diagonal: the condensation
 would carry over (S + D with a block-diagonal D), but it is kept 2-D only; 3-D uses
 :class:`BlockUpdateSolver` (J = A + blocks assembled, factorised or AMG-preconditioned by its KSP).
 """
@@ -64,7 +64,7 @@ class DiagonalUpdateSolver:
         self.K_full = None
         self._K_last, self._repeats = None, 0
         self._schur = None  # built at first need
-        # -<prefix>condense 0: factorise J at every new K instead (the behaviour before issue 18)
+        # -<prefix>condense 0: factorise J at every new K instead (the earlier behaviour)
         self.condense = PETSc.Options().getBool(prefix + "condense", True)
         self.full_factorizations = self.condensed_factorizations = 0
         self.full_solves = self.condensed_solves = 0
@@ -240,7 +240,7 @@ class DiagonalUpdatePC:
 
 class BlockUpdateSolver:
     """x = (A + sum_i E_i K_i E_i^T)^{-1} b for 2x2 blocks K_i on the two tangential dofs of each
-    contact node (3-D friction, issue 17; ``rows`` (nodes, 2) local indices of owned rows).
+    contact node (3-D friction; ``rows`` (nodes, 2) local indices of owned rows).
 
     The static condensation of :class:`DiagonalUpdateSolver` is 2-D only: here J is assembled
     (a copy of A plus the blocks, in A's sparsity: a node's dofs are coupled there) and

@@ -3,7 +3,7 @@
 Each function is a pure map of UFL expressions; the numbers in brackets are thesis equations,
 stated in docs/models.md ("Common notation"). ``B``, ``Phi_L``, ``split_norms_sq`` and
 ``von_mises`` take the dimension from their tensor argument: 2x2 gives the thesis' plane-stress
-expressions unchanged, 3x3 the 3-D ones of ``constitutive3d.py`` (issue 17).
+expressions unchanged, 3x3 the 3-D ones of ``constitutive3d.py``.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The 3-D counterparts of the plane-stress pieces of ``constitutive.py`` (issue 17), as UFL
+"""The 3-D counterparts of the plane-stress pieces of ``constitutive.py``, as UFL
 expressions of 3x3 tensors. ``constitutive.py`` dispatches to them on the tensor's shape, so a
 stepper takes the dimension from its mesh; the 2-D expressions are untouched.
 

@@ -29,7 +29,7 @@ def normal_compliance_term(u, w, n, c_nu, gap, dsC):
 #: j(w) = int g |w_tau| ds becomes the nodal sum sum_i m_i g_i |w_tau,i| (lumped boundary mass).
 #: All three friction solvers use this same discrete j, so they solve the same discrete problem.
 NODAL_QUADRATURE = {"quadrature_rule": "GLL", "quadrature_degree": 1}
-#: the same vertex rule on the triangular faces of a tetrahedral mesh (3-D, issue 17; the
+#: the same vertex rule on the triangular faces of a tetrahedral mesh (3-D; the
 #: metadata depends on the FFCx version: compat.facet_vertex_quadrature)
 NODAL_QUADRATURE_3D = compat.facet_vertex_quadrature()
 
@@ -54,7 +54,7 @@ def F_reg(r, g, eps_reg):
                            g * abs(r) - g * eps_reg / 2.0)
 
 
-# ---------------------------------------- Tresca friction in 3-D (issue 17): a tangent plane
+# ---------------------------------------- Tresca friction in 3-D: a tangent plane
 def tangential_part(v, n):
     """v_tau = v - (v.nu) nu, the tangential part of a vector (any dimension)."""
     return v - ufl.dot(v, n) * n

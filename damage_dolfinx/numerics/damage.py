@@ -84,7 +84,7 @@ class DamageStep:
         self.irreversible = irreversible
         if not self.obstacle:
             # linear_defaults: KSP options of the PDE form (None: direct, the matrix
-            # M + k kappa K being SPD by PETSc's Cholesky serially, issue 18; 3-D: scalable.py)
+            # M + k kappa K being SPD by PETSc's Cholesky serially; 3-D: scalable.py)
             self.linear = LinearSolver(a, L, [], prefix, context, constant_matrix=True,
                                        defaults=linear_defaults or
                                        serial_cholesky(V.mesh.comm, DIRECT))
@@ -102,11 +102,11 @@ class DamageStep:
                                self.b.duplicate(), self.A, OBSTACLE_DEFAULTS,
                                bounds=(self.lower, self.upper))
         self._atol = self.snes.snes.getTolerances()[1]
-        self.atol_rel = OBSTACLE_ATOL_REL  # a problem may lower it (3.3 wrench: 0, issue 18)
+        self.atol_rel = OBSTACLE_ATOL_REL  # a problem may lower it (3.3 wrench: 0)
         self._f0 = None
         self.snes.snes.setConvergenceTest(self._converged)
         self.lu_retries = 0
-        # issue 18: the SNES's first iteration with cached linear algebra (obstacle.py);
+        # The SNES's first iteration with cached linear algebra (obstacle.py);
         # -<prefix>vi_fast 0 restores the SNES alone, bit for bit
         self.fast = ObstacleFastPath(self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
                                      CHOLESKY_MAX_DOFS[V.mesh.topology.dim]) \
@@ -177,7 +177,7 @@ class DamageStep:
         # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
         # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
         atol = max(self._atol, self.atol_rel * self.b.norm()) if self.atol_rel else self._atol
-        if atol != self._atol_set:  # issue 18: PETSc is told only when it changes
+        if atol != self._atol_set:  # PETSc is told only when it changes
             self.snes.snes.setTolerances(atol=atol)
             self._atol_set = atol
             self._rtol = self.snes.snes.getTolerances()[0]

@@ -47,7 +47,7 @@ class MemoryTerm:
             raise InputError(f"memory mode {mode!r} does not apply to a {kernel.kind} kernel "
                              "(use 'sum' or the matching mode)")
         self.kernel, self.k, self.mode = kernel, float(k), mode
-        d = msh.topology.dim  # 2x2 (the thesis) or 3x3 tensors (issue 17)
+        d = msh.topology.dim  # 2x2 (the thesis) or 3x3 tensors
         self.space = compat.function_space(msh, "DG", 1, (d, d))
         self.M = fem.Function(self.space, name="memory")
         self.g = fem.Function(self.space, name="memory_integrand")

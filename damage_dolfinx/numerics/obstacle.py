@@ -1,4 +1,4 @@
-"""Fast path of the damage obstacle step (issue 18): vinewtonrsls's first iteration with cached
+"""Fast path of the damage obstacle step: vinewtonrsls's first iteration with cached
 linear algebra, accepted only where vinewtonrsls's own convergence test accepts it.
 
 The obstacle problem of every step is B z >= l on K^h = {zeta_star <= z <= 1} with B = M +
@@ -100,7 +100,7 @@ class ObstacleFastPath:
         self.rstart = B.getOwnershipRange()[0]
         self.F, self.x1 = B.createVecLeft(), B.createVecRight()
         self.y = B.createVecRight()
-        # their value arrays (stable views: the Vecs own them; issue 18, fewer calls a step)
+        # their value arrays (stable views: the Vecs own them, fewer calls a step)
         self._x1, self._y, self._f = self.x1.array, self.y.array, self.F.array
         self._serial = self.comm.size == 1
         self._full = None  # solver of B (empty active set)

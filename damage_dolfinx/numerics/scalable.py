@@ -1,4 +1,4 @@
-"""Solver defaults by dimension and size (issue 17): iterative solvers whose cost grows about
+"""Solver defaults by dimension and size: iterative solvers whose cost grows about
 linearly with the mesh, for 3-D.
 
 2-D keeps the package's direct defaults unchanged (they serve the thesis meshes well). In 3-D:

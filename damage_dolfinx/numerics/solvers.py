@@ -95,7 +95,7 @@ LAGGED_DIRECT = {"ksp_type": "cg", "ksp_rtol": 1e-12, "ksp_atol": 1e-50, "ksp_ma
 def serial_cholesky(comm, options: dict) -> dict:
     """``options`` (a factorisation by MUMPS LU) with PETSc's own Cholesky serially, for SPD
     matrices: its triangular solves are 2-3x faster than MUMPS's (spd_direct). Unchanged in
-    parallel. Measured at the convergence references, serially (issue 18): 2.1-ex1 at n = 160
+    parallel. Measured at the convergence references, serially: 2.1-ex1 at n = 160
     91 -> 47 ms per step, 2.3-ex1 at n = 256 306 -> 181 ms."""
     if comm.size > 1:
         return dict(options)

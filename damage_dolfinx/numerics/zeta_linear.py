@@ -1,5 +1,5 @@
 """Matrices whose entries are linear in the nodal damage zeta, updated by a precomputed sparse map
-instead of a re-assembly (issue 18): ZetaLinearMatrix, and VelocitySolver, the LinearSolver of the
+instead of a re-assembly: ZetaLinearMatrix, and VelocitySolver, the LinearSolver of the
 velocity step (3.159) of Section 3.3 built on it. Serial only (see ZetaLinearMatrix)."""
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from damage_dolfinx.numerics.solvers import ConvergenceError, LinearSolver, _rea
 class ZetaLinearMatrix:
     """The matrix of (3.159), A(zeta) = A_0 + W(zeta) (A_0 = rho/k M with the Dirichlet rows,
     W(zeta) = a_visc(zeta) linear in zeta), as CSR values data_0 + P C zeta: two sparse products
-    per step instead of a re-assembly (issue 18). On P1 the strains are constant on a cell, so
+    per step instead of a re-assembly. On P1 the strains are constant on a cell, so
     W(zeta) = sum_cells zbar_c K_c with zbar_c = C zeta the cell mean of zeta (exact: the
     quadrature of a_visc integrates the linear zeta exactly) and K_c the cell's matrix; P holds
     the K_c (about 36 values a cell, half the entries of the map through the nodal zeta). P is
@@ -187,8 +187,8 @@ class VelocitySolver(LinearSolver):
     (l_boundary, v_old, u_old, zeta_old, m_visc) (only for Phi_L = identity and homogeneous
     Dirichlet data) the right-hand side is rho/k M v_{n-1} - m_visc a_visc(zeta_{n-1}) u_{n-1}
     (two products with the same maps) plus the assembled boundary terms. ``solve`` is
-    LinearSolver.solve with the Python-level calls of a step cut to what a serial run needs
-    (issue 18): no ghost update, the homogeneous Dirichlet rows zeroed on the array."""
+    LinearSolver.solve with the Python-level calls of a step cut to what a serial run needs:
+    no ghost update, the homogeneous Dirichlet rows zeroed on the array."""
 
     def __init__(self, a, l, bcs, prefix, context, V, a_mass, a_visc, zeta, rhs=None, defaults=None):
         super().__init__(a, l, bcs, prefix, context, constant_matrix=False,

@@ -3,7 +3,7 @@ images copied into ``report/images/``), REPORT.md and, with ``--pdf``, REPORT.pd
 that still reads and displays when the folder is moved or zipped.
 
 Sources (report_sources.py), each traceable to the command that produced it: the figure runs,
-the convergence studies, the thesis tables beside ours (benchmarks/fidelity.py), the bridge
+the convergence studies, the thesis tables beside ours (benchmarks/reproduction/fidelity.py), the bridge
 summary, the benchmark records (report_records.py), every example's assumptions (the
 catalogue). The document: title block with the count of each verdict class, contents, summary
 (one row per thesis table and figure with its graded verdict: report_verdicts.py, checks in

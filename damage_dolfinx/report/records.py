@@ -1,14 +1,14 @@
 """The report's benchmark records (report.py builds the document): wall times of the
 reproduction, the performance record, the friction CPU comparison (thesis Tables 2.2/2.3), the
-bridge failure load, the per-step cost against its floor (benchmarks/step_floor.py) and the 3-D
-scaling record (benchmarks/threed_scaling.py). Each reads the committed output
+bridge failure load, the per-step cost against its floor (benchmarks/performance/step_floor.py) and the 3-D
+scaling record (benchmarks/performance/threed_scaling.py). Each reads the committed output
 in ``benchmarks/reference_output/`` (or the results folder) and names the command behind it.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]  # the checkout (damage_dolfinx/report/records.py)
 REFERENCE = REPO / "benchmarks" / "reference_output"
 
 
@@ -35,11 +35,11 @@ def _wall_times(doc, fig_index, conv_index):
     doc.markdown_table("| run | status | wall time [s] |\n|---|---|---|\n"
                        + "".join(f"| {name} | {status} | {t:.1f} |\n" for name, status, t in rows)
                        + f"| **total** | | **{total:.0f}** ({total / 3600:.2f} h) |\n")
-    check = REFERENCE / "reproduction_issue18" / "reproduction_check.md"
+    check = REFERENCE / "reproduction" / "reproduction_check.md"
     if check.is_file():
         doc.para("**The committed one-command reproduction**: `make convergence NP=2` and `make "
                  "figures NP=2` on one checkout, each once, on a quiet 2-core machine, compared "
-                 "with the committed tables by `python benchmarks/reproduction_check.py` (target: "
+                 "with the committed tables by `python benchmarks/reproduction/reproduction_check.py` (target: "
                  "both together within 40 minutes; every error equal to the committed one to a "
                  f"relative 1e-6). From the committed record `{check.name}`:")
         text = check.read_text()
@@ -71,12 +71,12 @@ def _explain_check(doc, record_path):
 
 
 def _performance(doc, results):
-    """Time per step vs dofs, serial and 2 ranks (benchmarks/performance.py)."""
+    """Time per step vs dofs, serial and 2 ranks (benchmarks/performance/performance.py)."""
     doc.anchor_heading(2, "Performance: time per step vs dofs, serial and 2 MPI ranks",
                        "performance")
     for table in (results / "performance" / "performance.md", REFERENCE / "performance" / "performance.md"):
         if table.is_file():
-            doc.para(f"`python benchmarks/performance.py`, from `{_shown(table)}`.")
+            doc.para(f"`python benchmarks/performance/performance.py`, from `{_shown(table)}`.")
             doc.markdown_table(table.read_text())
             doc.note("Columns: dofs (u) = displacement unknowns; serial / 2 ranks = wall time per "
                      "time step; speed-up = serial over 2-rank time per step; `(ref)` marks the "
@@ -95,7 +95,7 @@ def _bridge(doc, s, path):
              f"{s.get('n_mechanism_hinges', s['n_hinges'])} of them mechanism hinges (rotation "
              f"in the collapse step at least 0.2 x the largest); "
              f"calibration: {s.get('calibrated')}; source `{_shown(path)}` "
-             f"(`benchmarks/bridge_collapse.py`).")
+             f"(`benchmarks/studies/bridge_collapse.py`).")
 
 
 def _friction_cpu(doc):
@@ -109,14 +109,14 @@ def _friction_cpu(doc):
     table = REFERENCE / "friction_cpu" / "cpu.md"
     if table.is_file():
         doc.para("CPU comparison of the three friction solvers (thesis Tables 2.2/2.3; "
-                 "`python benchmarks/friction_cpu_2_2.py`, committed output "
+                 "`python benchmarks/studies/friction_cpu_2_2.py`, committed output "
                  "`benchmarks/reference_output/friction_cpu/cpu.md`):")
         doc.markdown_table(table.read_text())
         doc.note(explain)
     stick = REFERENCE / "friction_cpu_stick" / "cpu.md"
     if stick.is_file():
         doc.para("The same with stick-slip (friction bound g = 200 instead of 5, Uzawa step "
-                 "rho = 1e-3 from a sweep of rho at n = 16; `python benchmarks/friction_cpu_2_2.py "
+                 "rho = 1e-3 from a sweep of rho at n = 16; `python benchmarks/studies/friction_cpu_2_2.py "
                  "--set g_fric=200 rho_uzawa=1e-3`, output "
                  "`benchmarks/reference_output/friction_cpu_stick/cpu.md`):")
         doc.markdown_table(stick.read_text())
@@ -127,17 +127,15 @@ def _step_floor(doc):
     """Per-step cost of every problem against one SpMV / CG iteration / Cholesky solve."""
     doc.anchor_heading(2, "Per-step cost against its floor", "step-floor")
     folder = REFERENCE / "step_floor"
-    # the newest record of each size first
-    tables = [(label, next((folder / f"step_floor_{tag}{suffix}.md"
-                            for suffix in ("_s10", "_s9", "_s8", "_vi_after", "_after")
-                            if (folder / f"step_floor_{tag}{suffix}.md").is_file()), None))
+    # the newest record of each size: step_floor_<tag>_<date>.md, the ISO date sorts last
+    tables = [(label, max(folder.glob(f"step_floor_{tag}_*.md"), default=None))
               for label, tag in (("about 4k dofs (n = 45)", "n45"),
                                  ("reference size (n = 255, 131k dofs)", "n255"))]
     tables = [(label, t) for label, t in tables if t is not None]
     if not tables:
-        doc.para("No per-step profile (`python benchmarks/step_floor.py`).")
+        doc.para("No per-step profile (`python benchmarks/performance/step_floor.py`).")
         return
-    doc.para("`python benchmarks/step_floor.py` (serial; each problem at its own k; steps after "
+    doc.para("`python benchmarks/performance/step_floor.py` (serial; each problem at its own k; steps after "
              "the first two, history scalars included). The floor is measured on the vector P1 "
              "matrix M + K of the same mesh: one sparse matrix-vector product, one CG + Jacobi "
              "iteration and one Cholesky solve (PETSc's). Target: at most 5x the floor at about "
@@ -146,14 +144,10 @@ def _step_floor(doc):
              "iteration, 4-40 CG iterations): the last two columns count, from PETSc's event "
              "log, the triangular-solve pairs, SpMVs and factorisations of a step and the time "
              "PETSc spends in its numerical kernels, and give the step over its own solves and "
-             "over its own arithmetic (benchmarks/README.md, 'per-step cost').")
+             "over its own arithmetic (benchmarks/README.md, 'Performance against the floor').")
     for label, table in tables:
         doc.para(f"**{label}**, from `{_shown(table)}`:")
         doc.markdown_table(table.read_text())
-        if table.stem.endswith("_vi_after"):
-            doc.note("Measured on the shared machine at load 2-4: the wall times and the floors "
-                     "are inflated; the CPU column and the damage-step split are the solid "
-                     "numbers (benchmarks/README.md, the damage obstacle step's fast path).")
 
 
 def _threed_scaling(doc):
@@ -166,7 +160,7 @@ def _threed_scaling(doc):
                         ("scaling_dynamic", "dynamic (3.1-ex1-3d)")):
         table, plot = folder / f"{stem}.md", folder / f"{stem}.png"
         if table.is_file():
-            doc.para(f"**{label}**, `python benchmarks/threed_scaling.py`, from `{_shown(table)}`:")
+            doc.para(f"**{label}**, `python benchmarks/performance/threed_scaling.py`, from `{_shown(table)}`:")
             doc.markdown_table(table.read_text())
             shown = True
         if plot.is_file():
@@ -178,4 +172,4 @@ def _threed_scaling(doc):
                  f"`{_shown(extrapolation)}`:")
         doc.markdown_table(extrapolation.read_text())
     if not shown:
-        doc.para("No 3-D scaling record (`python benchmarks/threed_scaling.py`).")
+        doc.para("No 3-D scaling record (`python benchmarks/performance/threed_scaling.py`).")

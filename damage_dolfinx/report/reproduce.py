@@ -82,7 +82,7 @@ def _quick_options(ex) -> list:
 
 
 def _reading_options(reading) -> list:
-    """``--reading NAME`` (issue 16), or nothing for each example's default reading."""
+    """``--reading NAME``, or nothing for each example's default reading."""
     return ["--reading", reading] if reading else []
 
 
@@ -185,7 +185,7 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, rea
     """Run every figure job, copy the PNGs into ``out`` and write ``out/index.json``. With
     ``resume``, jobs that completed in an earlier invocation (same mode) are kept, not rerun.
 
-    Two lanes (issue 18): the SERIAL jobs (the wrench, 3.3-ex2: long serial loops) run one
+    Two lanes: the SERIAL jobs (the wrench, 3.3-ex2: long serial loops) run one
     after the other on one rank, while the other jobs run beside them on np_ - 1 ranks, and on
     np_ ranks once the serial lane is done. index.json lists the runs in catalogue order."""
     import threading
@@ -274,8 +274,8 @@ def _figure_run(job, ranks, runs, out, resume) -> tuple:
 
 
 def _bridge_force_displacement(mode, out, np_, index):
-    """Figure 2.7 (force-displacement curve of the arch) from benchmarks/bridge_collapse.py."""
-    script = Path(__file__).resolve().parents[1] / "benchmarks" / "bridge_collapse.py"
+    """Figure 2.7 (force-displacement curve of the arch) from benchmarks/studies/bridge_collapse.py."""
+    script = Path(__file__).resolve().parents[2] / "benchmarks" / "studies" / "bridge_collapse.py"
     if not script.is_file():
         return
     folder = out / "runs" / "bridge_collapse"
@@ -290,7 +290,7 @@ def _bridge_force_displacement(mode, out, np_, index):
     with open(folder / "log.txt", "w") as f:
         code = subprocess.call(argv, stdout=f, stderr=subprocess.STDOUT, env=env)
     command = (f"mpirun -n {np_} " if np_ > 1 else "") + \
-        f"python benchmarks/bridge_collapse.py {' '.join(options)} --out {folder}"
+        f"python benchmarks/studies/bridge_collapse.py {' '.join(options)} --out {folder}"
     index["runs"].append({"example": "2.1-ex3", "variant": "force-displacement",
                           "command": command, "returncode": code,
                           "wall_time_s": round(time.perf_counter() - start, 2), "folder": str(folder)})

@@ -1,7 +1,7 @@
 """Where the report's data come from: the figure runs (``<results>/figures/index.json``, full
 resolution, else ``figures-quick``), the convergence studies (``<results>/convergence/<study>/``
 if present, else the committed outputs in ``benchmarks/reference_output/convergence/``), the
-thesis tables beside ours (benchmarks/fidelity.py) and the bridge summary.
+thesis tables beside ours (benchmarks/reproduction/fidelity.py) and the bridge summary.
 """
 from __future__ import annotations
 
@@ -33,10 +33,10 @@ def _study_folder(results: Path, name: str):
 
 
 def _fidelity(results: Path):
-    """benchmarks/fidelity.py's comparison (None if the script is absent, e.g. an installed
+    """benchmarks/reproduction/fidelity.py's comparison (None if the script is absent, e.g. an installed
     package without the repository)."""
     import importlib.util
-    script = REPO / "benchmarks" / "fidelity.py"
+    script = REPO / "benchmarks" / "reproduction" / "fidelity.py"
     if not script.is_file():
         return None
     spec = importlib.util.spec_from_file_location("damage_dolfinx_fidelity", script)

@@ -42,7 +42,7 @@ def headline(counts: dict) -> str:
 
 
 def table_verdict(t: dict) -> str:
-    """A thesis error table beside our study (benchmarks/fidelity.py's comparison)."""
+    """A thesis error table beside our study (benchmarks/reproduction/fidelity.py's comparison)."""
     from damage_dolfinx.report.checks import departure
     v = t.get("verdict", "not comparable")
     if v.startswith("not comparable"):

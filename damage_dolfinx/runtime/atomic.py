@@ -1,4 +1,4 @@
-"""Writes that fail cleanly (issue 20): files written to a temporary file and renamed into
+"""Writes that fail cleanly: files written to a temporary file and renamed into
 place (a kill never leaves a truncated file, a failed write gives its space back), and I/O
 errors turned into one line, OutputError, raised on every rank (``collective``), so ranks never
 wait for each other and the command line exits with status 4.

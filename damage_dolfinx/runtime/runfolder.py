@@ -1,4 +1,4 @@
-"""The run folder (issue 20): its lock (a second run into a folder where one is live is refused;
+"""The run folder: its lock (a second run into a folder where one is live is refused;
 a dead run's lock, even after SIGKILL, never blocks), the run it already holds, and removing
 that run's files (--overwrite)."""
 from __future__ import annotations

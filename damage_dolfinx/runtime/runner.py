@@ -85,7 +85,7 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     run is live is always refused (runfolder.RunLock). Output errors raise io.OutputError, signals
     RunInterrupted, both after recording the status in summary.json.
 
-    History cadence (issue 18): ``history_every`` (default: the example's parameter
+    History cadence: ``history_every`` (default: the example's parameter
     ``history_every``, else 1) writes a history.csv row every that many steps, plus the first,
     the last and a stopping step. In between, the stepper only updates what summary.json reports
     over all steps (``stepper.track()``: the 3.3 maximal interpenetration, its time and place;
@@ -304,7 +304,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             row = stepper.n % history_every == 0 or stepper.n == N
             if row:
                 scalars = record(stats, step_time)
-            else:  # between history rows: only the extremes over all steps (issue 18)
+            else:  # between history rows: only the extremes over all steps
                 track()
                 scalars = stepper.scalars
             since_checkpoint, elapsed, signum = end_of_step()
@@ -388,7 +388,7 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
     if fig.kind == "problem":  # drawn by the stepper (collective): the vault's hinge lines
         stepper.draw_figure(fig, out / filename)
         return {"file": filename}
-    if fig.kind == "slices" or stepper.mesh.topology.dim == 3:  # 3-D runs: fields on plane sections (issue 17, slices.py)
+    if fig.kind == "slices" or stepper.mesh.topology.dim == 3:  # 3-D runs: fields on plane sections (slices.py)
         from damage_dolfinx.viz.slices import plot_slices
         planes = plot_slices([(stepper.von_mises, "von Mises stress [Pa]"),
                               (stepper.zeta, "damage zeta [-]")], out / filename,

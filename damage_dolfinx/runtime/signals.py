@@ -1,4 +1,4 @@
-"""Signals (issue 20): SIGTERM, SIGINT and SIGUSR1 stop a run at the end of the current step,
+"""Signals: SIGTERM, SIGINT and SIGUSR1 stop a run at the end of the current step,
 with a checkpoint, status "interrupted" and exit status 128 + signal (RunInterrupted)."""
 from __future__ import annotations
 

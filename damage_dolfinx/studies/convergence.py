@@ -8,8 +8,8 @@ reference mesh (:func:`post.nested_transfer`, P1 or DG0) and its error is measur
               (default ||u_ref - u_hk||_V + ||zeta_ref - zeta_hk||_Y; each problem sets the
               norm its thesis table uses, e.g. ||sigma||_Q for 2.4, ||v||_H for 3.1),
 
-so no reference history is stored. Everything runs under MPI. By default (reference_ranks 1,
-issue 18) the reference runs serially on rank 0 and every cell serially on the other ranks,
+so no reference history is stored. Everything runs under MPI. By default (reference_ranks 1)
+the reference runs serially on rank 0 and every cell serially on the other ranks,
 which send their cells' nodal values to rank 0 without waiting for it; with ``--reference-ranks
 all`` the reference and the cells n > SERIAL_CELL_MAX_N run on all ranks and the smaller cells
 serially, shared out among all ranks. The norm is one product with a Gram matrix.
@@ -184,7 +184,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     1 runs the reference serially on rank 0 and every coarse cell serially on the other ranks
     (the measurements on rank 0); "all" runs the reference and the cells n > SERIAL_CELL_MAX_N
     on all ranks, the smaller cells serially shared out among all ranks. On 2 cores the first
-    is faster for every thesis study (issue 18, benchmarks/README.md): a serial step uses
+    is faster for every thesis study (benchmarks/README.md): a serial step uses
     PETSc's Cholesky and the serial-only zeta-linear matrices of 3.3, MUMPS on 2 ranks is no
     faster than that, and the second rank is free for the cells. A finer reference on many
     ranks wants "all"."""

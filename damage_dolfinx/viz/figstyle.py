@@ -1,6 +1,6 @@
 """One figure style for every PNG of the package (thesis figures, histories, settings).
 
-Rules (GitHub issue 19), each applied here and nowhere else:
+Rules, each applied here and nowhere else:
 
 * damage on a fixed colour scale [zeta*, 1] -- never autoscaled -- with the label
   "zeta (1 = sound, zeta* = fully damaged)"; if the field leaves that range (the PDE damage law of
@@ -24,6 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
+from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks,  # noqa: F401
+                        is_damage, narrow_damage, shared_limits, si_unit)
+from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
+                      error_mathtext, is_round, mathtext, round_amplification)
+from .setting_geometry import (outward_normals, spread, support_hatch,  # noqa: F401
+                               thin_out, traction_arrows)
+
 #: suffix of the panel data written beside a field figure (figure_2_1.png -> figure_2_1.panel.npz)
 PANEL_SUFFIX = ".panel.npz"
 
@@ -31,108 +38,6 @@ DPI = 150
 DAMAGE_CMAP = "viridis"        # dark = low zeta = damaged (stated in the colour-bar label)
 STRESS_CMAP = "inferno"
 DAMAGE_LABEL = "$\\zeta$ (1 = sound,\n$\\zeta^*$ = fully damaged)"
-#: factors stated in thesis captions (2.12 x3, 3.4 x4); kept as the thesis prints them
-THESIS_FACTORS = (3.0, 4.0)
-
-_MATH = [  # (pattern, replacement), applied in order to ASCII labels
-    (r"\bvon Mises stress\b", r"von Mises stress $\\sigma_{VM}$"),
-    (r"\bvon Mises norm of the strain\b", r"von Mises norm of the strain $\\varepsilon_{VM}$"),
-    (r"\bGamma_([DNC])\b", r"$\\Gamma_\1$"),
-    (r"\bzeta_star\b", r"$\\zeta^*$"),
-    (r"\bdamage zeta\b", "damage"),
-    (r"\bzeta\b", r"$\\zeta$"),
-    (r"\bsigma_tau\b", r"$\\sigma_\\tau$"),
-    (r"\bsigma_nu\b", r"$\\sigma_\\nu$"),
-    (r"\bu_tau\b", r"$u_\\tau$"),
-    (r"\bu_(\d)\b", r"$u_\1$"),
-    (r"\bx([12])\b(?=\s*[=\[,)])(?<!\(x[12])", r"$x_\1$"),  # x1 [m], x2 = 3; not '(x2)' factors
-    (r"\beps_reg\b", r"$\\varepsilon$"),
-]
-
-
-def mathtext(label: str) -> str:
-    """ASCII names in a label -> matplotlib mathtext (Gamma_D -> $\\Gamma_D$, zeta -> $\\zeta$,
-    x1 -> $x_1$, u_1 -> $u_1$, von Mises stress -> ... $\\sigma_{VM}$)."""
-    if "$" in label:
-        return label
-    for pattern, repl in _MATH:
-        label = re.sub(pattern, repl, label)
-    return label
-
-
-def error_mathtext(definition: str) -> str:
-    """A convergence error definition (convergence.py) in mathtext:
-    'max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)' -> max_n (||u - u^hk||_V + ...)."""
-    greek = {"zeta": r"\zeta", "sigma": r"\sigma", "eta": r"\eta"}
-
-    def norm(m):
-        x = greek.get(m.group(1), m.group(1))
-        space = {"L2": "L^2"}.get(m.group(2), m.group(2))
-        return rf"\|{x} - {x}^{{hk}}\|_{{{space}}}"
-    text = re.sub(r"\|\|(\w+) - \1_hk\|\|_(\w+)", norm, definition)
-    if text == definition:
-        return mathtext(definition)
-    return "$" + text.replace("max_n", r"\max_n\,") + "$"
-
-
-# ---------------------------------------------------------------------------- amplification
-def round_amplification(a: float) -> float:
-    """The largest factor of the 1-2-5 series (x 10^k) not above ``a`` (0 stays 0)."""
-    if not a or not math.isfinite(a) or a <= 0:
-        return 0.0 if not a else 1.0
-    exp = math.floor(math.log10(a))
-    for m in (5.0, 2.0, 1.0):
-        if m * 10.0 ** exp <= a * (1 + 1e-9):
-            return float(f"{m * 10.0 ** exp:.12g}")
-    return float(f"{10.0 ** exp:.12g}")
-
-
-def is_round(a: float) -> bool:
-    """True for 0 (undeformed), the 1-2-5 series and the thesis's own factors."""
-    if a == 0 or a in THESIS_FACTORS:
-        return True
-    return a > 0 and abs(round_amplification(a) - a) <= 1e-9 * a
-
-
-def drawn_amplification(a: float) -> float:
-    """The factor a figure is drawn with: ``a`` if round (or a thesis factor), else rounded."""
-    return a if is_round(a) else round_amplification(a)
-
-
-def amplification_text(a: float) -> str:
-    """How the title states the factor ('' for the undeformed configuration)."""
-    if not a:
-        return "undeformed configuration"
-    if a == 1:
-        return "true displacements (×1)"
-    if a < 1:
-        return f"displacements shrunk ×{a:g}"
-    return f"displacements ×{a:g}"
-
-
-# ---------------------------------------------------------------------------- colour limits
-def is_damage(name: str, label: str = "") -> bool:
-    return name == "zeta" or "zeta" in label.lower() or "damage" in label.lower()
-
-
-def damage_limits(values, zeta_star: float, tol: float = 1e-9):
-    """(vmin, vmax, note): [zeta*, 1] unless the field leaves it; then the actual extremes,
-    and ``note`` says so (printed in the panel title)."""
-    v = np.asarray(values, float)
-    lo, hi = float(np.nanmin(v)), float(np.nanmax(v))
-    vmin, vmax, notes = zeta_star, 1.0, []
-    if lo < zeta_star - tol:
-        vmin = lo
-        notes.append(f"min $\\zeta$ = {lo:.3g} < $\\zeta^*$")
-    if hi > 1 + tol:
-        vmax = hi
-        notes.append(f"max $\\zeta$ = {hi:.3g} > 1")
-    return vmin, vmax, "; ".join(notes)
-
-
-def shared_limits(arrays):
-    """(0, max) over several arrays: one stress scale for the panels of a thesis pair."""
-    return 0.0, max(float(np.nanmax(np.asarray(a, float))) for a in arrays)
 
 
 # ---------------------------------------------------------------------------- drawing
@@ -171,34 +76,10 @@ def colorbar(fig, ax, mappable, label, ticks=None):
     return cb
 
 
-#: SI prefixes a stress scale is written in (never a "1e6" multiplier over the colour bar)
-SI_PREFIXES = ((1e9, "G"), (1e6, "M"), (1e3, "k"), (1.0, ""))
-
-
-def si_unit(label: str, vmax: float):
-    """(label, scale): a label ending in a unit ``[Pa]`` (or ``[N]``, ``[m]`` ...) rewritten
-    with the SI prefix that keeps the largest value below 1000 (``[MPa]``, scale 1e6); other
-    labels unchanged (scale 1)."""
-    m = re.search(r"\[(Pa|N|N/m|N/m\^?2|J)\]$", label)
-    if not m or not vmax or not math.isfinite(vmax):
-        return label, 1.0
-    scale, prefix = next(((f, p) for f, p in SI_PREFIXES if abs(vmax) >= f), (1.0, ""))
-    return label[:m.start()] + f"[{prefix}{m.group(1)}]", scale
-
-
 def plain_ticks(axis, scale=1.0):
     """Tick labels ``value / scale`` written out in full (``%g``): no offset, no multiplier."""
     from matplotlib.ticker import FuncFormatter
     axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v / scale:.4g}"))
-
-
-def damage_ticks(vmin, vmax, zeta_star):
-    ticks = [t for t in np.linspace(0, 1, 6) if vmin <= t <= vmax]
-    if vmin <= zeta_star <= vmax and all(abs(t - zeta_star) > 0.05 * (vmax - vmin) for t in ticks):
-        ticks = [zeta_star] + ticks
-    if vmin < zeta_star:
-        ticks = [vmin] + [t for t in ticks if t - vmin > 0.08 * (vmax - vmin)]
-    return sorted(ticks)
 
 
 def boundary_edges(xy):
@@ -318,17 +199,6 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     return used
 
 
-#: a damage field whose range covers less than this fraction of [zeta*, 1] is one colour on the
-#: fixed scale: the figure adds a panel on the field's own range (red frame on the fixed bar)
-NARROW_DAMAGE = 0.25
-
-
-def narrow_damage(lo: float, hi: float, zeta_star: float) -> bool:
-    """True when the damage range [lo, hi] is too narrow to be seen on the fixed [zeta*, 1]
-    scale but not constant (a constant field has nothing to stretch)."""
-    return hi - lo < NARROW_DAMAGE * (1 - zeta_star) and hi - lo > 1e-6
-
-
 def _stretched_damage(fig, ax, tri, vals, lo, hi):
     """The same damage field on a colour scale stretched to its own range [lo, hi]."""
     if vals.ndim == 2:
@@ -407,66 +277,6 @@ def inside_test(cells):
                              return_inverse=True)
     finder = mtri.Triangulation(pts[:, 0], pts[:, 1], inverse.reshape(-1, 3)).get_trifinder()
     return lambda p: finder(np.asarray(p)[:, 0], np.asarray(p)[:, 1]) >= 0
-
-
-def outward_normals(segs, inside, size):
-    """Unit normals of boundary segments (nseg, 2, 2) pointing out of the body."""
-    d = segs[:, 1] - segs[:, 0]
-    length = np.linalg.norm(d, axis=1)[:, None]
-    tangent = d / np.where(length > 0, length, 1)
-    normal = np.stack([tangent[:, 1], -tangent[:, 0]], 1)
-    probe = segs.mean(1) + 0.2 * size * normal
-    normal[inside(probe)] *= -1
-    return normal
-
-
-def thin_out(segs, spacing):
-    """About one segment per ``spacing`` of boundary length (markers, arrows)."""
-    length = np.linalg.norm(segs[:, 1] - segs[:, 0], axis=1)
-    return np.diff(np.floor(np.concatenate([[0.0], np.cumsum(length)]) / spacing)) > 0
-
-
-def support_hatch(segs, inside, size):
-    """Short oblique ticks on the outer side of boundary segments (the clamp / foundation
-    symbol), about one per 1.5 ``size`` of boundary length."""
-    segs = segs[thin_out(segs, 1.5 * size)]
-    normal = outward_normals(segs, inside, size)
-    tangent = np.stack([-normal[:, 1], normal[:, 0]], 1)
-    mid = segs.mean(1)
-    return np.stack([mid, mid + size * (normal - 0.6 * tangent)], 1)
-
-
-def traction_arrows(segs, vectors, inside, size):
-    """(tails, deltas) of arrows for a traction on boundary segments, lengths 3 ``size`` x
-    |f| / max |f|: a pull starts at the boundary and points away from the body, a push ends on
-    it, a mostly tangential (shear) load is drawn along the boundary, just outside it."""
-    vectors = np.asarray(vectors, float)
-    norm = np.linalg.norm(vectors, axis=1)
-    keep = norm > 1e-12 * max(norm.max(initial=0.0), 1e-300)
-    segs, vectors, norm = segs[keep], vectors[keep], norm[keep]
-    if not len(segs):
-        return np.zeros((0, 2)), np.zeros((0, 2))
-    deltas = 3 * size * vectors / norm.max()
-    mid, normal = segs.mean(1), outward_normals(segs, inside, size)
-    cos = np.einsum("ij,ij->i", vectors, normal) / norm
-    tails = np.where((cos > 0.5)[:, None], mid, mid - deltas)
-    shear = np.abs(cos) <= 0.5
-    tails[shear] = mid[shear] + 1.2 * size * normal[shear] - deltas[shear] / 2
-    return tails, deltas
-
-
-def spread(points, spacing):
-    """Indices of ``points`` keeping one per square of side ``spacing`` (the one nearest the
-    square's centre): evenly spread markers and arrows."""
-    points = np.asarray(points, float)
-    if not len(points):
-        return np.zeros(0, dtype=np.int64)
-    rel = (points - points.min(0)) / spacing
-    keys = np.floor(rel).astype(np.int64)
-    dist = np.linalg.norm(rel - keys - 0.5, axis=1)
-    order = np.lexsort((dist, keys[:, 1], keys[:, 0]))
-    _, first = np.unique(keys[order], axis=0, return_index=True)
-    return np.sort(order[first])
 
 
 def body_force_points(cells, spacing):

@@ -1,4 +1,4 @@
-"""Figures of the barrel vault's collapse (issue 17, example 2.1-ex3-vault): the hinge lines and
+"""Figures of the barrel vault's collapse (example 2.1-ex3-vault): the hinge lines and
 the load-displacement curve.
 
 * ``plot_hinge_lines``: the damage zeta on the extrados and on the intrados, unrolled (abscissa

@@ -313,7 +313,7 @@ def _strongest_load(expr, constants, t_const, times, points):
 
 
 def _draw_outline(ax, xy):
-    """Boundary edges of the undeformed mesh (kept for benchmarks/lshape_3_1.py)."""
+    """Boundary edges of the undeformed mesh (kept for benchmarks/studies/lshape_3_1.py)."""
     from damage_dolfinx.viz import figstyle
     figstyle.draw_outline(ax, xy)
 

@@ -1,4 +1,4 @@
-"""Figures of 3-D runs (issue 17): fields sampled on plane sections through the body.
+"""Figures of 3-D runs: fields sampled on plane sections through the body.
 
 Each field (von Mises, damage) is evaluated on a regular grid of points in a coordinate plane
 (``compat.locate_points`` + ``Function.eval``, in parallel: every rank evaluates the points in

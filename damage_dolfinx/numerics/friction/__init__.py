@@ -27,7 +27,7 @@ Uzawa and penalty-duality factorise their constant matrix once and update nodal 
 with NumPy (no loops over dofs); both stop when ||v_{s+1} - v_s||_V <= tol ||v_{s+1}||_V
 (thesis: tol = 1e-6).
 
-3-D (issue 17): the same four iterations with a 2-D tangent plane, w_tau a 2-vector per node
+3-D: the same four iterations with a 2-D tangent plane, w_tau a 2-vector per node
 (two coordinate-axis tangents; Gamma_C made of faces parallel to coordinate planes, others are
 refused), |w_tau| its Euclidean norm: Phi_eps(s) = g s / max(|s|, eps) (in 2-D this is
 g max(-1, min(1, s/eps)), (2.99)), Newton's Jacobian blocks m g/eps I (stick) and

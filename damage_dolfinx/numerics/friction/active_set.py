@@ -34,7 +34,7 @@ class PrimalDualActiveSet:
     The stopping test is the primal Newton's: ||F(v)|| of :class:`AlgebraicResidual`.
     Needs axis-parallel tangents (tau tau^T diagonal), like the bilateral contact conditions.
 
-    3-D (issue 17): lambda_i and v_tau,i are 2-vectors, |.| the Euclidean norm, P the projection
+    3-D: lambda_i and v_tau,i are 2-vectors, |.| the Euclidean norm, P the projection
     onto the unit disc; the linearisation of |s| lambda = s on a sliding node gives the 2x2 block
     m g (I - lambda n^T)/|s| (n = s/|s|), not symmetric unless lambda is parallel to n, and the
     multiplier update lambda <- P(lambda + (I - lambda n^T) s_new/|s|) (its fixed point with
@@ -61,7 +61,7 @@ class PrimalDualActiveSet:
                                      op=MPI.LAND)
         self.rows = 2 * self.nodes.dofs + np.argmax(np.abs(tau), axis=1)  # owned tangential dofs
         self.free_rows = self._free(self.rows)
-        # J = A + diag(K on the free tangential dofs): no factorisation per new K (issue 18)
+        # J = A + diag(K on the free tangential dofs): no factorisation per new K
         self.solver = DiagonalUpdateSolver(residual.A, np.sort(self.rows[self.free_rows]), prefix)
         self._order = np.argsort(self.rows[self.free_rows])
 

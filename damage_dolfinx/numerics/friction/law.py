@@ -4,7 +4,7 @@ contact nodes: scalars (shape (nodes,)) in 2-D, tangent-plane vectors (nodes, 2)
     Phi_eps(s) = g s / max(|s|, eps)    (2-D: g max(-1, min(1, s/eps)), the same function)
     F_eps(s)   = g |s|^2 / (2 eps) for |s| <= eps,  g |s| - g eps/2 otherwise
 
-The 2-D branches are the expressions the package used before issue 17, unchanged (2-D results
+The 2-D branches are the expressions the package used before the 3-D extension, unchanged (2-D results
 identical bit for bit); the 3-D branches are the same law with |.| the Euclidean norm, the stick
 test |s|^2 <= eps^2 as in the UFL form (contact.Phi_reg_vector)."""
 from __future__ import annotations

@@ -97,7 +97,7 @@ class RegularisedNewton:
         self.prefix = prefix
         # Newton's linear solves by the active-set iteration's DiagonalUpdateSolver where the
         # Jacobian is A + diag(K(stick set)) (checked): no assembly and no factorisation per
-        # new stick set (issue 18)
+        # new stick set
         # 3-D: the Jacobian A + 2x2 blocks assembled algebraically (checked against UFL's)
         if problem.dim == 3:
             self.condensed = self.pdas is not None and self._algebraic_jacobian_3d(J)

@@ -2,7 +2,7 @@
 vertices with their lumped weights, unit tangents and friction bounds (:class:`ContactNodes`),
 shared by every friction solver (nodal quadrature of j(w) = int_{Gamma_C} g |w_tau| ds).
 
-2-D: one tangent per node, v_tau a scalar (arrays of shape (nodes,)). 3-D (issue 17): a tangent
+2-D: one tangent per node, v_tau a scalar (arrays of shape (nodes,)). 3-D: a tangent
 plane spanned by two orthonormal tangents per node, v_tau a 2-vector (arrays (nodes, 2)); the
 faces of Gamma_C must be parallel to coordinate planes (the tangents are then the two other
 coordinate axes); other faces are refused (InputError)."""

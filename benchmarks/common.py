@@ -1,0 +1,81 @@
+"""Helpers shared by the benchmark scripts (each script puts this folder on ``sys.path`` and
+imports it): the checkout's folders, the fastest-of-blocks timing and the per-problem record of
+the step profiles (performance/step_floor.py), and the field comparison of the platform checks
+(platforms/cross_version.py, platforms/ranks_check.py)."""
+import json
+import os
+import subprocess
+import time
+from pathlib import Path
+
+import numpy as np
+
+BENCHMARKS = Path(__file__).resolve().parent
+REPO = BENCHMARKS.parent
+#: the committed records, one folder per topic (benchmarks/README.md names each)
+RECORDS = BENCHMARKS / "reference_output"
+#: the thesis error tables (transcribed from the thesis; Tables 2.1 and 3.3 withheld)
+THESIS_TABLES = BENCHMARKS / "thesis_tables.json"
+
+
+def commit() -> str:
+    """Short hash of the checkout's HEAD ('unknown' outside git)."""
+    out = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
+                         capture_output=True, text=True)
+    return out.stdout.strip() or "unknown"
+
+
+def best(fn, repeat, blocks=5) -> float:
+    """Seconds per call of fn, the fastest of ``blocks`` blocks (robust on a loaded machine)."""
+    fastest = float("inf")
+    for _ in range(blocks):
+        start = time.perf_counter()
+        for _ in range(repeat):
+            fn()
+        fastest = min(fastest, (time.perf_counter() - start) / repeat)
+    return fastest
+
+
+def profile_rows(problems, only, profile) -> list:
+    """profile(example) for each problem (those in ``only`` if given), each row printed as JSON
+    as soon as it is measured."""
+    rows = []
+    for example in problems:
+        if only and example not in only:
+            continue
+        rows.append(profile(example))
+        print(json.dumps(rows[-1]), flush=True)
+    return rows
+
+
+def write_record(out, stem, rows, lines, **extra):
+    """``<out>/<stem>.json`` (extra keys, date, load average, commit, rows) and ``<stem>.md``
+    (the table ``lines``, also printed)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / f"{stem}.json").write_text(json.dumps(
+        {**extra, "date": time.strftime("%Y-%m-%d"),
+         "load_average": [round(x, 2) for x in os.getloadavg()],
+         "commit": commit(), "rows": rows}, indent=1))
+    (out / f"{stem}.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
+
+
+def sorted_fields(path, names) -> dict:
+    """The nodal fields ``names`` of a fields_final.npz, each with its coordinates, in the order
+    of their coordinates (so that runs on different partitions or versions compare)."""
+    data = np.load(path)
+    out = {}
+    for name in names:
+        if name not in data or name + "_coords" not in data:
+            continue
+        X = np.round(np.asarray(data[name + "_coords"], float), 10)
+        order = np.lexsort(X.T[::-1])
+        out[name] = (X[order], np.asarray(data[name]).reshape(len(X), -1)[order])
+    return out
+
+
+def rel(a, b) -> float:
+    """Relative l2 difference of a from b."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return float(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300))

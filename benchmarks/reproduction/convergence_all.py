@@ -1,0 +1,34 @@
+"""All convergence studies of the thesis (Tables 2.1, 2.4, 2.5, 2.6, 2.7, 3.1, 3.2, 3.3).
+
+    python benchmarks/reproduction/convergence_all.py [--quick] [--np 2] [--out results/convergence] [--only ID ...]
+                                         [--reading literal|evidence]
+
+Each study runs as `mpirun -n NP damage-dolfinx converge ID` at the catalogue's thesis settings
+(fine reference computed in parallel), writing errors.csv/.md, convergence.png (log-log with the
+fitted rates) and summary.json (wall time of the reference run) into OUT/<id>[-variant];
+OUT/index.json lists commands, rates and wall times.
+"""
+import argparse
+from pathlib import Path
+
+from damage_dolfinx.report import reproduce
+
+p = argparse.ArgumentParser()
+p.add_argument("--quick", action="store_true", help="three coarse meshes, small reference")
+p.add_argument("--np", type=int, default=2, help="MPI ranks")
+p.add_argument("--out", default=None)
+p.add_argument("--only", nargs="+", help="example ids")
+p.add_argument("--resume", action="store_true",
+               help="keep the runs that completed in an earlier invocation into the same OUT")
+p.add_argument("--reading", choices=("literal", "evidence"),
+               help="thesis data literally or the evidence reading (default: each example's "
+                    "default_reading)")
+a = p.parse_args()
+mode = "quick" if a.quick else "full"
+out = Path(a.out or ("results/convergence-quick" if a.quick else "results/convergence"))
+index = reproduce.run_convergence(mode, out, a.np, a.only, a.resume, a.reading)
+for s in index["studies"]:
+    rate = s.get("rates", {}).get("h_plus_k_all")
+    print(f"{s['example']} {s['variant']}: exit {s['returncode']}, {s['wall_time_s']} s, "
+          f"rate in h + k {rate if rate is None else round(rate, 3)}")
+print(f"total {index['wall_time_s']} s on {a.np} ranks -> {out}")
