@@ -43,6 +43,9 @@ RUNS = [
     ("3.2-ex1", ["--n", "8", "--k", "0.02"]),
     ("3.3-ex1", ["--n", "8", "--k", "0.01", "--T", "0.5"]),
     ("3.3-ex3", ["--h", "0.3", "--k", "2e-5", "--T", "0.002"]),
+    # a gmsh-written mesh file (the unit square, tags 1-3) read by each version's own reader path
+    ("2.2-ex1", ["--mesh", str(Path(__file__).resolve().parents[2] / "tests" / "data" /
+                               "rectangle.msh"), "--k", "0.01", "--T", "0.2"]),
 ]
 SKIP_TOP = {"schema", "example", "title", "section", "status", "parameters", "n", "h", "k", "T",
             "num_steps", "steps_done", "t_final", "mpi_size", "mesh", "assumptions", "outputs",
