@@ -136,7 +136,7 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
     (and the figure gets a panel on the field's range); a failed check 'differs'; a run under a
     fitted reading 'reproduced under a reading' with the departure named."""
     import numpy as np
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     from damage_dolfinx.report.checks import departure, judge
     from damage_dolfinx.report.figures import ThesisFigure
     from damage_dolfinx.report.verdicts import CLASSES, category
@@ -172,7 +172,7 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
 
 def test_reader_text_and_units():
     """Thesis line numbers become sections and pages, codes their meaning; stresses in MPa."""
-    from damage_dolfinx import figstyle
+    from damage_dolfinx.viz import figstyle
     from damage_dolfinx.report.text import assumption, forbidden, reader_text
     assert reader_text("(thesis line 3973)") == "(thesis §3.2.3, p. 176)"
     assert assumption("G6: kappa = 1e-2 (missing in the thesis)") == \
