@@ -366,10 +366,10 @@ def _cases():
     # -- 5. strict JSON
     case("one-level converge (rates without a value)", "json",
          [*conv, "--n", "5", "--k", "0.25", "--out", OUT], expect="ok", fast=False)
-    # -- the stability check of 3.3-ex1
-    case("3.3-ex1 at k = 3.1 k_max", "state",
+    # -- the stability check of 3.3-ex1: a chosen k above k_max is refused (--allow-unstable)
+    case("3.3-ex1 at k = 3.1 k_max", "ranges",
          ["run", "3.3-ex1", "--n", "8", "--k", "3.5", "--T", "7", "--no-figures", "--quiet",
-          "--out", OUT], expect="warned", fast=False)
+          "--out", OUT], fast=False)
     return c
 
 
