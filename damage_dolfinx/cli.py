@@ -1,11 +1,16 @@
 """Command line: ``damage-dolfinx list | run ID | converge ID`` (works unchanged under mpirun).
 
-Options the parser does not know (``-mech_ksp_type cg``, ``-damage_snes_monitor``) go to the
-PETSc options database. User errors print one line on rank 0 and exit with status 2; a solver
-that does not converge exits with status 3 after writing what was finished; an output error
+Single-dash options are PETSc options of the package's solvers (``-mech_ksp_type cg``,
+``-damage_snes_monitor``; prefixes PETSC_PREFIXES): any other single-dash word is refused with
+the double-dash option it resembles, a value PETSc refuses is refused before any work, and an
+option no solver read is named in a warning at the end. User errors print one line on rank 0
+and exit with status 2; a solver
+that does not converge or fails, or a state that is not finite or leaves [zeta_star, 1], exits
+with status 3 after writing what was finished (summary.json "failed"); an output error
 (disk full, I/O error, output folder deleted) exits with status 4; SIGTERM, SIGINT or SIGUSR1
 stop a run at the end of the current step with a checkpoint, exit status 128 + signal number
-(143, 130, 138).
+(143, 130, 138); a repeat of the signal within 5 s is ignored, a later one ends the process
+at once (signals.StopSignals).
 """
 from __future__ import annotations
 
@@ -13,13 +18,28 @@ import argparse
 import os
 import sys
 
+import numpy as np
 from mpi4py import MPI
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (InputError, exit status 2) and only the long form of
+    help: ``-h`` is the mesh size misspelt (--h), not a request for help."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("add_help", False)
+        super().__init__(*args, **kwargs)
+        self.add_argument("--help", action="help", help="show this help and exit")
+
+    def error(self, message):
+        from damage_dolfinx.parameters import InputError
+        raise InputError(message)
+
+
 def _parser():
-    p = argparse.ArgumentParser(prog="damage-dolfinx", allow_abbrev=False,
-                                description="Damage models of Campo (2007) with DOLFINx.")
-    sub = p.add_subparsers(dest="command", required=True)
+    p = _Parser(prog="damage-dolfinx", allow_abbrev=False,
+                description="Damage models of Campo (2007) with DOLFINx.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sub.add_parser("list", help="list the example ids")
 
     def common(sp):
@@ -61,7 +81,8 @@ def _parser():
     run.add_argument("--restart", action="store_true",
                      help="resume from the checkpoint in --out (any number of MPI ranks)")
     run.add_argument("--overwrite", action="store_true",
-                     help="replace a run already in --out (without it such a folder is refused)")
+                     help="replace a run already in --out: the files its manifest.json lists "
+                          "(without it such a folder is refused)")
 
     conv = sub.add_parser("converge", help="convergence study against a fine reference",
                           allow_abbrev=False)
@@ -74,23 +95,125 @@ def _parser():
                       help="the reference on rank 0 alone, every cell serially on the other "
                            "ranks (1), or the reference and the cells n > 64 on all ranks "
                            "(all); default: the example's choice (convergence.py)")
+    conv.add_argument("--restart", action="store_true",
+                      help="a study already in --out: nothing to do if it finished with these "
+                           "settings, else it runs again (studies keep no checkpoints)")
+    conv.add_argument("--overwrite", action="store_true",
+                      help="replace a study already in --out: the files its manifest.json lists")
     return p
 
 
-def _petsc_options(tokens):
-    """Put '-name [value]' tokens into the PETSc options database; returns unparsed leftovers."""
+#: prefixes of the package's PETSc solvers (an option -<prefix><name> reaches one of them)
+PETSC_PREFIXES = ("mech_", "damage_", "friction_", "uzawa_", "pd_", "stability_")
+#: PETSc options without a solver prefix that are accepted (diagnostics of the whole run)
+PETSC_GLOBAL = ("log_view", "options_left", "options_view", "info", "malloc_dump",
+                "memory_view", "log_trace")
+#: the part of an option name after which the PETSc object's own options start
+_OBJECT_PARTS = ("snes_", "ksp_", "pc_")
+
+
+def _petsc_options(tokens, parser, command):
+    """Check the tokens argparse did not know and put the PETSc options among them into the
+    options database; returns {name: value} of those set. Raises InputError for a single-dash
+    word that is no PETSc option of the package's solvers (suggesting the double-dash option),
+    an unknown double-dash option and a stray word."""
     from petsc4py import PETSc
-    opts, leftovers, i = PETSc.Options(), [], 0
+    from damage_dolfinx.parameters import InputError
+    given, i = {}, 0
     while i < len(tokens):
         tok = tokens[i]
-        if tok.startswith("-") and not tok.startswith("--") and len(tok) > 1:
-            value = tokens[i + 1] if i + 1 < len(tokens) and not _is_option(tokens[i + 1]) else None
-            opts[tok[1:]] = value if value is not None else ""
-            i += 2 if value is not None else 1
-        else:
-            leftovers.append(tok)
-            i += 1
-    return leftovers
+        value = tokens[i + 1] if i + 1 < len(tokens) and not _is_option(tokens[i + 1]) else None
+        if tok.startswith("--"):
+            raise InputError(f"unrecognised option {tok.split('=')[0]}"
+                             f"{_suggestion(tok.split('=')[0], parser, command)}")
+        if not tok.startswith("-") or len(tok) == 1 or not _is_option(tok):
+            raise InputError(f"unrecognised argument {tok!r}")
+        name = tok[1:]
+        if not (name.startswith(PETSC_PREFIXES) or name in PETSC_GLOBAL):
+            hint = _suggestion("--" + name, parser, command)
+            raise InputError(f"unknown option {tok}: not a PETSc option of this program's "
+                             f"solvers (prefixes {', '.join(PETSC_PREFIXES)}){hint}")
+        given[name] = value if value is not None else ""
+        i += 2 if value is not None else 1
+    opts = PETSc.Options()
+    for name, value in given.items():
+        opts[name] = value
+    return given
+
+
+def _suggestion(option, parser, command) -> str:
+    """'; did you mean --x?' for the closest option of the command, or ''."""
+    import difflib
+    sub = _subparser(parser, command)
+    known = [o for a in (sub or parser)._actions for o in a.option_strings if o.startswith("--")]
+    if option in known:
+        return f"; did you mean {option}?"
+    close = difflib.get_close_matches(option, known, n=1, cutoff=0.6)
+    return f"; did you mean {close[0]}?" if close else ""
+
+
+def _subparser(parser, command):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            return action.choices.get(command)
+    return None
+
+
+def _check_petsc_values(given):
+    """Every PETSc option given is applied to a throwaway SNES (with its KSP and PC) of its
+    prefix, so that a value PETSc refuses (-mech_ksp_type nonsense) is refused now, before any
+    work, with one line; the options are then set anew, so that whether a solver of the run
+    reads them (``_unused``) is not confused by this check."""
+    from petsc4py import PETSc
+    from damage_dolfinx.parameters import InputError
+    prefixes = set()
+    for name in given:
+        cut = [name.find(part) for part in _OBJECT_PARTS if name.find(part) > 0]
+        if cut and name.startswith(PETSC_PREFIXES):
+            prefixes.add(name[:min(cut)])
+    for prefix in sorted(prefixes):
+        snes = PETSc.SNES().create(PETSc.COMM_SELF)
+        try:
+            snes.setOptionsPrefix(prefix)
+            snes.setFromOptions()
+        except PETSc.Error as exc:
+            lines = [line.strip().lstrip("[0123456789] ") for line in str(exc).splitlines()]
+            reason = next((line for line in reversed(lines) if line and "() at " not in line),
+                          f"error code {exc.ierr}")
+            options = " ".join(f"-{n} {v}".strip() for n, v in given.items()
+                               if n.startswith(prefix))
+            raise InputError(f"PETSc refuses the options {options}: {reason}") from None
+        finally:
+            snes.destroy()
+    opts = PETSc.Options()
+    for name, value in given.items():
+        opts.delValue(name)
+        opts[name] = value
+
+
+def _unused(given, comm):
+    """The PETSc options given that no solver of the run read (all ranks agree), or []."""
+    from damage_dolfinx import compat
+    names = [n for n in given if n not in PETSC_GLOBAL]
+    used = [compat.petsc_option_used(n) for n in names]
+    if any(u is None for u in used):
+        return []
+    used = comm.allreduce(np.array(used, dtype=np.int32), op=MPI.MAX) if names else []
+    return [f"-{n}" for n, u in zip(names, used) if not u]
+
+
+def _forget(given):
+    """Remove the options of this command, and the solvers' defaults, from the PETSc database
+    (a later command in the same process, e.g. the tests, starts clean)."""
+    from petsc4py import PETSc
+    opts = PETSc.Options()
+    for name in given:
+        opts.delValue(name)
+    if "dolfinx" in sys.modules:  # a solver may have run
+        from damage_dolfinx.numerics import solvers
+        for name in list(solvers._CODE_DEFAULTS):
+            opts.delValue(name)
+        solvers._CODE_DEFAULTS.clear()
 
 
 def _is_option(tok):
@@ -134,16 +257,17 @@ def _check_finite(args):
 
 def main(argv=None):
     comm = MPI.COMM_WORLD
-    args, extra = _parser().parse_known_args(argv)
     from damage_dolfinx.parameters import InputError
     from damage_dolfinx.numerics.solvers import ConvergenceError
     from damage_dolfinx.runtime.io import OutputError
     from damage_dolfinx.runtime.runner import RunInterrupted
+    given = {}
     try:
-        leftovers = _petsc_options(extra)
-        if leftovers:
-            raise InputError(f"unrecognised arguments: {' '.join(leftovers)}")
+        parser = _parser()
+        args, extra = parser.parse_known_args(argv)
+        given = _petsc_options(extra, parser, args.command)
         _check_finite(args)
+        _check_petsc_values(given)
         if args.command == "list":
             from damage_dolfinx.catalogue import examples
             if comm.rank == 0:
@@ -161,8 +285,7 @@ def main(argv=None):
                        figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
                        checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
                        overwrite=args.overwrite, history_every=args.history_every)
-            return 0
-        if args.command == "converge":
+        elif args.command == "converge":
             from damage_dolfinx.studies import convergence
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
                               ns=args.n, ks=args.k, T=args.T,
@@ -170,8 +293,14 @@ def main(argv=None):
                                                    args.friction_law, args.reading, args),
                               progress=not args.quiet,
                               reference_ranks={"1": 1, "all": "all", None: None}[
-                                  args.reference_ranks])
-            return 0
+                                  args.reference_ranks],
+                              restart=args.restart, overwrite=args.overwrite)
+        unused = _unused(given, comm)
+        if unused and comm.rank == 0:
+            print(f"damage-dolfinx: warning: no solver of this {args.command} read the PETSc "
+                  f"option(s) {' '.join(unused)}: they had no effect", file=sys.stderr,
+                  flush=True)
+        return 0
     except InputError as exc:
         if comm.rank == 0:
             print(f"damage-dolfinx: error: {exc}", file=sys.stderr, flush=True)
@@ -197,7 +326,8 @@ def main(argv=None):
         if comm.rank == 0:
             print(f"damage-dolfinx: {exc}", file=sys.stderr, flush=True)
         return exc.exit_status
-    return 1
+    finally:
+        _forget(given)
 
 
 if __name__ == "__main__":

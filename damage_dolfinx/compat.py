@@ -393,3 +393,33 @@ def facet_vertex_coords(msh, facets):
         cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))
         nodes = dolfinx.cpp.mesh.entities_to_geometry(cpp_mesh, 1, facets, False)
     return msh.geometry.x[nodes][:, :, :2]
+
+
+# ---------------------------------------------------------------------------- PETSc options
+_PETSC_LIBRARY = []
+
+
+def petsc_option_used(name: str):
+    """Whether a solver read the PETSc option ``name`` (no leading dash) since it was set
+    (PetscOptionsUsed; petsc4py 3.18 has no binding for it), or None where the PETSc library
+    cannot be found."""
+    import ctypes
+    if not _PETSC_LIBRARY:
+        path = None
+        try:
+            with open("/proc/self/maps") as maps:
+                path = next((line.split()[-1] for line in maps
+                             if "/libpetsc" in line and ".so" in line), None)
+        except OSError:
+            pass
+        try:
+            _PETSC_LIBRARY.append(ctypes.CDLL(path) if path else None)
+        except OSError:
+            _PETSC_LIBRARY.append(None)
+    lib = _PETSC_LIBRARY[0]
+    if lib is None or not hasattr(lib, "PetscOptionsUsed"):
+        return None
+    flag = ctypes.c_int(0)
+    if lib.PetscOptionsUsed(None, name.encode(), ctypes.byref(flag)) != 0:
+        return None
+    return bool(flag.value)

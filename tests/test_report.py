@@ -103,7 +103,7 @@ def test_resumed_reproduction_keeps_completed_runs(tmp_path):
     interrupted one goes on from its checkpoint (--restart)."""
     out = tmp_path / "figures"
     first = reproduce.run_figures("quick", out, np_=1, only=["2.1-ex1"])
-    log = out / "runs" / "2.1-ex1" / "log.txt"
+    log = out / "runs" / "2.1-ex1.log.txt"
     stamp = log.stat().st_mtime_ns
     second = reproduce.run_figures("quick", out, np_=1, only=["2.1-ex1", "2.3-ex1"], resume=True)
     assert log.stat().st_mtime_ns == stamp                      # not rerun

@@ -157,6 +157,8 @@ class Example:
         if time.num_steps > MAX_STEPS and not allow_long:
             raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
                              f"{MAX_STEPS:.0e}; choose a larger k, or --allow-long")
+        if mesh_file is not None and self.dim != 2:
+            raise InputError(f"--mesh reads 2-D gmsh meshes; example {self.id} is {self.dim}-D")
         if mesh_file is None and not self.own:
             from mpi4py import MPI
             from damage_dolfinx.runtime.resources import check_memory
@@ -164,6 +166,14 @@ class Example:
             # cell of a convergence study is built on one rank alone)
             check_memory(self, n, h, comm or MPI.COMM_WORLD)
         return params, time, n, h, mesh_file
+
+    def mesh_requirements(self):
+        """(dimension, facet tags) a --mesh file must have: those of the built-in geometry
+        (built serially at the default size; runfolder.check_mesh_file)."""
+        import numpy as np
+        from mpi4py import MPI
+        geometry = self.make_geometry(MPI.COMM_SELF, self.n, self.h)
+        return self.dim, tuple(int(t) for t in np.unique(geometry.facet_tags.values))
 
     def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None):
         """Mesh, data and time stepper of one run (after validation)."""

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from damage_dolfinx.viz import figstyle
+from damage_dolfinx.runtime.atomic import strict_json
 
 #: variants of an example that the thesis draws separately: suffix -> parameter overrides
 VARIANTS = {
@@ -203,7 +204,7 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, rea
             entries = [results[j.name] for j in jobs if j.name in results]
             index["runs"] = [e for e, _ in entries]
             index["figures"] = [f for _, figs in entries for f in figs]
-            (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+            (out / "index.json").write_text(strict_json(index))
 
     def run_job(job, ranks):
         if job.name in done:
@@ -238,7 +239,7 @@ def run_figures(mode: str, out: Path, np_: int = 2, only=None, resume=False, rea
         index["runs"].append(done["2.1-ex3-force-displacement"])
         index["figures"] += [f for f in old_figures if f["file"] == "figure_2_7.png"]
     _finish(index, "runs", start)
-    (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    (out / "index.json").write_text(strict_json(index))
     return index
 
 
@@ -252,7 +253,8 @@ def _figure_run(job, ranks, runs, out, resume) -> tuple:
     run_dir.mkdir(parents=True, exist_ok=True)
     command = ["run", job.example, *job.options, "--quiet", "--out", str(run_dir),
                *(["--restart"] if restart else [])]
-    code, wall, _ = _launch(command, ranks, run_dir / "log.txt")
+    # the log beside the run folder: the run folder holds only what the run writes (manifest)
+    code, wall, _ = _launch(command, ranks, runs / f"{job.name}.log.txt")
     entry = {"example": job.example, "variant": job.variant, "command": _display(command, ranks),
              "returncode": code, "wall_time_s": round(wall, 2), "folder": str(run_dir)}
     figures = []
@@ -318,8 +320,9 @@ def run_convergence(mode: str, out: Path, np_: int = 2, only=None, resume=False,
             continue
         folder = out / job.name
         folder.mkdir(parents=True, exist_ok=True)
-        command = ["converge", job.example, *job.options, "--quiet", "--out", str(folder)]
-        code, wall, _ = _launch(command, np_, folder / "log.txt")
+        command = ["converge", job.example, *job.options, "--quiet", "--overwrite",
+                   "--out", str(folder)]
+        code, wall, _ = _launch(command, np_, out / f"{job.name}.log.txt")
         entry = {"example": job.example, "variant": job.variant, "command": _display(command, np_),
                  "returncode": code, "wall_time_s": round(wall, 2), "folder": str(folder)}
         summary = folder / "summary.json"
@@ -333,7 +336,7 @@ def run_convergence(mode: str, out: Path, np_: int = 2, only=None, resume=False,
                 entry["figure"] = f"{stem}.png"
         index["studies"].append(entry)
         print(f"[convergence] {job.name}: exit {code}, {wall:.1f} s", flush=True)
-        (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+        (out / "index.json").write_text(strict_json(index))
     _finish(index, "studies", start)
-    (out / "index.json").write_text(json.dumps(index, indent=2) + "\n")
+    (out / "index.json").write_text(strict_json(index))
     return index

@@ -86,11 +86,42 @@ def atomic_write_bytes(path, write, fsync=False):
 
 
 def write_json(path, data, comm=MPI.COMM_WORLD):
-    """Atomically write ``data`` as JSON (rank 0; raises OSError there)."""
+    """Atomically write ``data`` as strict JSON (rank 0; raises OSError there): see
+    ``strict_json``."""
     if comm.rank != 0:
         return
-    text = json.dumps(data, indent=2, sort_keys=False, default=_json_default) + "\n"
+    text = strict_json(data)
     atomic_write_bytes(path, lambda f: f.write(text.encode()))
+
+
+def strict_json(data, indent=2) -> str:
+    """``data`` as JSON that every reader accepts: a NaN or an infinity (which Python's json
+    would write as the bare words NaN / Infinity) becomes null, and a top-level dict gains
+    ``null_values``: {"key.path": "NaN" | "Infinity" | "-Infinity"} saying what it was."""
+    reasons = {}
+    clean = _finite(data, "", reasons)
+    if reasons and isinstance(clean, dict):
+        clean["null_values"] = {**(clean.get("null_values") or {}), **reasons}
+    return json.dumps(clean, indent=indent, sort_keys=False, default=_json_default,
+                      allow_nan=False) + "\n"
+
+
+def _finite(value, where, reasons):
+    if isinstance(value, (np.floating, np.integer, np.bool_)):
+        value = value.item()
+    elif isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, float):
+        if value != value or value in (float("inf"), float("-inf")):
+            reasons[where.lstrip(".") or "value"] = ("NaN" if value != value else
+                                                    "Infinity" if value > 0 else "-Infinity")
+            return None
+        return value
+    if isinstance(value, dict):
+        return {k: _finite(v, f"{where}.{k}", reasons) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v, f"{where}[{i}]", reasons) for i, v in enumerate(value)]
+    return value
 
 
 def _json_default(obj):

@@ -74,7 +74,7 @@ def save(out, state: dict, meta: dict, comm=MPI.COMM_WORLD):
         keys, vals = comm.gather(_owned_keys(f), root=0), comm.gather(_values(f), root=0)
         if comm.rank == 0:
             gathered[name + "__keys"], gathered[name] = np.concatenate(keys), np.concatenate(vals)
-    text = json.dumps({"format": FORMAT, **meta}, indent=2) + "\n"
+    text = io.strict_json({"format": FORMAT, **meta})
     gathered["__meta__"] = np.array(text)
 
     def write():
@@ -113,17 +113,20 @@ def _latest(out: Path):
             continue
         try:
             with np.load(path) as data:
-                for key in data.files:
-                    data[key]  # reads (and CRC-checks) every array
-                meta = json.loads(str(data["__meta__"])) if "__meta__" in data.files else \
+                arrays = {key: data[key] for key in data.files}  # reads (CRC-checks) each
+                meta = json.loads(str(arrays["__meta__"])) if "__meta__" in arrays else \
                     json.loads((out / "checkpoint.json").read_text())  # pre-generation format
         except Exception as exc:  # noqa: BLE001 - any unreadable file: try the next generation
             if name != GENERATIONS[2]:
                 size = path.stat().st_size
                 notes.append(f"{name} is unreadable ({type(exc).__name__}, {size} bytes)")
             continue
-        if meta.get("format") != FORMAT:
+        if not isinstance(meta, dict) or meta.get("format") != FORMAT:
             notes.append(f"{name} is not a {FORMAT} checkpoint")
+            continue
+        problem = _problem(arrays, meta)
+        if problem:
+            notes.append(f"{name} {problem}")
             continue
         return path, meta, notes, None
     if not notes:
@@ -132,7 +135,29 @@ def _latest(out: Path):
     return None, None, [], f"cannot restart: no readable checkpoint in {str(out)!r} ({'; '.join(notes)})"
 
 
-def resume_point(out, settings, grid, previous, comm=MPI.COMM_WORLD):
+def _problem(arrays: dict, meta: dict):
+    """What makes a readable checkpoint unusable (None: nothing): a value that is not finite,
+    keys and values of different lengths, metadata without a whole step and a finite time."""
+    step, t = meta.get("step"), meta.get("t")
+    if isinstance(step, bool) or not isinstance(step, int) or step < 0:
+        return f"has step = {step!r} in its metadata, not a whole number >= 0"
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not np.isfinite(t):
+        return f"has t = {t!r} in its metadata, not a finite number"
+    for key, value in arrays.items():
+        if key == "__meta__":
+            continue
+        if value.dtype.kind in "fc" and not np.isfinite(value).all():
+            return f"holds non-finite values (NaN or Inf) in {key!r}"
+        if key.endswith("__keys"):
+            field = arrays.get(key[:-len("__keys")])
+            if field is None or value.ndim != 2 or value.shape[1] not in (2, 3, 4, 6) \
+                    or len(field) != len(value):
+                return (f"has {key!r} of shape {value.shape} for "
+                        f"{None if field is None else field.shape} values")
+    return None
+
+
+def resume_point(out, settings, grid, previous, comm=MPI.COMM_WORLD, parameters=None):
     """(checkpoint file, its metadata) after checking it belongs to this run, or None when the
     run in ``out`` (``previous``: its summary or None) finished and this T adds no step (nothing
     to do). Raises InputError if it cannot be resumed."""
@@ -140,13 +165,22 @@ def resume_point(out, settings, grid, previous, comm=MPI.COMM_WORLD):
     try:
         path, meta = latest(out, comm)
     except InputError:
-        if not finished:
-            raise
+        if not finished or any((Path(out) / name).exists() for name in GENERATIONS):
+            raise  # says which checkpoint file is unusable and why
         path, meta = None, {key: previous.get(key) for key in ("example", "n", "k")}
     for key, value in settings.items():
         if key in meta and meta.get(key) != value:
             raise InputError(f"cannot restart: the {'checkpoint' if path else 'run'} in "
                              f"{str(out)!r} has {key} = {meta.get(key)!r}, this run {value!r}")
+    saved = meta.get("parameters") if path else (previous or {}).get("parameters")
+    if parameters is not None and isinstance(saved, dict):
+        now = json.loads(io.strict_json(parameters))
+        changed = sorted(key for key in set(saved) | set(now) if saved.get(key) != now.get(key))
+        if changed:
+            key = changed[0]
+            raise InputError(f"cannot restart: the {'checkpoint' if path else 'run'} in "
+                             f"{str(out)!r} has {key} = {saved.get(key)!r}, this run "
+                             f"{now.get(key)!r} (the model parameters differ)")
     if finished and (previous["status"] != "completed" or grid.num_steps <= previous["steps_done"]):
         return None
     if path is None:
@@ -175,14 +209,23 @@ def _match(saved: np.ndarray, local: np.ndarray) -> np.ndarray:
 
 def load(path, state: dict):
     """Set every Function (and NumPy array, in place) of ``state`` from the checkpoint file
-    ``path`` (from ``latest``; any number of ranks)."""
+    ``path`` (from ``latest``; any number of ranks); InputError naming the file for a field
+    that is missing or has the wrong shape."""
     data = np.load(path)
     for name, f in state.items():
         if name not in data:
-            raise InputError(f"cannot restart: the checkpoint has no field {name!r}")
+            raise InputError(f"cannot restart: {path.name} has no field {name!r}")
         if isinstance(f, np.ndarray):
+            if data[name].shape != f.shape:
+                raise InputError(f"cannot restart: {path.name} has {name!r} of shape "
+                                 f"{data[name].shape}, this run {f.shape}")
             f[...] = data[name]
             continue
+        if name + "__keys" not in data or data[name].reshape(len(data[name]), -1).shape[1] \
+                != _values(f).shape[1] or data[name + "__keys"].shape[1] != \
+                _owned_keys(f).shape[1]:
+            raise InputError(f"cannot restart: {path.name} has {name!r} of shape "
+                             f"{data[name].shape}, not that of this run's field")
         index = _match(data[name + "__keys"], _owned_keys(f))
         _values(f)[:] = data[name][index]
         f.x.scatter_forward()

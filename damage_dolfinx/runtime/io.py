@@ -27,7 +27,7 @@ from mpi4py import MPI
 
 from damage_dolfinx import compat
 from damage_dolfinx.runtime.atomic import (STUCK_SECONDS, OutputError, atomic_write_bytes, collective,  # noqa: F401
-                     describe, npz_writer, write_json)
+                     describe, npz_writer, strict_json, write_json)
 from damage_dolfinx.parameters import InputError
 
 
@@ -38,8 +38,8 @@ def prepare_output_dir(path, comm=MPI.COMM_WORLD) -> Path:
     if comm.rank == 0:
         try:
             path.mkdir(parents=True, exist_ok=True)
-            probe = path / ".write_test"
-            probe.write_text("ok")
+            probe = path / f".damage-dolfinx-write-test-{os.getpid()}"  # never a user's file
+            os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))
             probe.unlink()
         except OSError as exc:
             error = f"output folder {str(path)!r} is not writable: {exc.strerror or exc}"

@@ -1,11 +1,14 @@
-"""The run folder: its lock (a second run into a folder where one is live is refused;
-a dead run's lock, even after SIGKILL, never blocks), the run it already holds, and removing
-that run's files (--overwrite)."""
+"""The output folder: its lock (a second run into a folder where one is live is refused; a dead
+run's lock, even after SIGKILL, never blocks), the run it already holds, its manifest (what the
+package wrote in it: --overwrite removes exactly that, and a file the package did not write is
+never touched) and the checks of a mesh file before it is used (``check_mesh_file``)."""
 from __future__ import annotations
 
 import fcntl
 import json
+import math
 import os
+import re
 import socket
 import time
 from pathlib import Path
@@ -15,7 +18,8 @@ from mpi4py import MPI
 from damage_dolfinx.runtime import checkpoint
 from damage_dolfinx.parameters import InputError
 
-#: files of a run that --overwrite removes (figures are overwritten by the new run)
+#: files of a run written before manifests existed (what --overwrite removes there, with the
+#: outputs its summary.json names)
 RUN_FILES = ("summary.json", "history.csv", "fields_final.npz", "checkpoint.json",
              *checkpoint.GENERATIONS)
 
@@ -98,29 +102,274 @@ def _alive(pid, host) -> bool:
     return True
 
 
+def _summary_problem(data, kind="run"):
+    """What is wrong with a summary read from disk (None: usable)."""
+    schema = {"run": "damage-dolfinx/summary/v1", "study": "damage-dolfinx/convergence/v1"}[kind]
+    if not isinstance(data, dict):
+        return "not a JSON object"
+    if data.get("schema") != schema:
+        return f"schema {data.get('schema')!r}, expected {schema!r}"
+    if kind == "run":
+        steps, t = data.get("steps_done"), data.get("t_final")
+        if not isinstance(data.get("status"), str):
+            return "no status"
+        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
+            return f"steps_done = {steps!r} is not a whole number >= 0"
+        if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+            return f"t_final = {t!r} is not a finite number"
+    return None
+
+
 def previous_run(out, comm):
-    """The summary of a run already in ``out`` (with a 'description'), or None."""
+    """The summary of a run already in ``out`` (with a 'description'), or None. A summary that
+    cannot be read or is not a run's summary counts as an unreadable run (a restart then
+    relies on the checkpoint alone; see checkpoint.resume_point)."""
     result = None
     if comm.rank == 0:
         try:
             result = json.loads((out / "summary.json").read_text())
+            problem = _summary_problem(result)
+            if problem:
+                result = {"status": "unreadable", "steps_done": "?",
+                          "problem": f"summary.json: {problem}"}
         except FileNotFoundError:
             if any((out / name).exists() for name in checkpoint.GENERATIONS):
                 result = {"status": "running", "steps_done": "?"}
-        except (OSError, ValueError):
-            result = {"status": "unreadable", "steps_done": "?"}
+        except (OSError, ValueError) as exc:
+            result = {"status": "unreadable", "steps_done": "?",
+                      "problem": f"summary.json: {type(exc).__name__}"}
         if result is not None:
             status = result.get("status")
             kind = {"running": "an interrupted run", "interrupted": "an interrupted run",
-                    "failed": "a failed run"}.get(status, f"a finished run ({status})")
+                    "failed": "a failed run", "unreadable": "a run with an unreadable summary"
+                    }.get(status, f"a finished run ({status})")
             result["description"] = (f"{kind} of {result.get('example', '?')} "
                                      f"({result.get('steps_done')} steps done)")
     return comm.bcast(result, root=0)
 
 
-def remove_run_files(out, comm):
+# ---------------------------------------------------------------------------- the manifest
+#: what the package wrote in a folder: {"schema", "kind": "run" | "study", "files": [names]}
+MANIFEST = "manifest.json"
+MANIFEST_SCHEMA = "damage-dolfinx/manifest/v1"
+#: names the package uses for its own bookkeeping (the lock, the writability probe)
+HIDDEN = (".lock",)
+#: files of a convergence study
+STUDY_FILES = ("summary.json", "errors.csv", "errors.md", "convergence.png")
+_LEGACY_FIELDS = re.compile(r"fields(_from_step\d+)?\.(xdmf|h5|xdmf\.bak)$")
+
+
+def _ours(name, files) -> bool:
+    """``name`` is a listed file or the temporary file of one (atomic.py: NAME.tmp)."""
+    return name in files or (name.endswith(".tmp") and name[:-4] in files) or name in HIDDEN
+
+
+def read_manifest(out):
+    """(kind, set of names) of ``out``'s manifest, or None without one; raises InputError
+    for a manifest that cannot be used (rank 0)."""
+    path = Path(out) / MANIFEST
+    if not path.exists():
+        return None
+    try:
+        data = json.loads(path.read_text())
+        files = data["files"]
+        if data.get("schema") != MANIFEST_SCHEMA or data.get("kind") not in ("run", "study") \
+                or not isinstance(files, list) or not all(
+                    isinstance(f, str) and f and "/" not in f and f not in (".", "..")
+                    for f in files):
+            raise ValueError("not a damage-dolfinx manifest")
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise InputError(f"{str(path)!r} is unreadable ({exc}); nothing in {str(out)!r} was "
+                         "touched: move the folder aside or choose another --out") from None
+    return data["kind"], set(files) | {MANIFEST}
+
+
+def _legacy(out):
+    """(kind, names) of a folder written before manifests existed, from its summary (exact
+    names, never a pattern that could match a user's file), or None."""
+    try:
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        summary = None
+    if isinstance(summary, dict) and summary.get("schema") == "damage-dolfinx/convergence/v1":
+        return "study", set(STUDY_FILES)
+    run = isinstance(summary, dict) and summary.get("schema") == "damage-dolfinx/summary/v1"
+    if not run and not any((out / name).exists() for name in checkpoint.GENERATIONS):
+        return None
+    names = set(RUN_FILES) | {n.name for n in out.iterdir() if _LEGACY_FIELDS.match(n.name)}
+    if run:
+        outputs = summary.get("outputs") if isinstance(summary.get("outputs"), dict) else {}
+        for key in ("xdmf", "history", "final_fields"):
+            if isinstance(outputs.get(key), str):
+                names.add(outputs[key])
+        for fig in outputs.get("figures") or []:
+            if isinstance(fig, dict) and isinstance(fig.get("file"), str):
+                names.add(fig["file"])
+    return "run", {n for n in names if "/" not in n}
+
+
+def folder_contents(out):
+    """(kind or None, the package's files present, the other files present) of ``out``
+    (rank 0); InputError for an unusable manifest."""
+    out = Path(out)
+    present = {p.name for p in out.iterdir()} if out.is_dir() else set()
+    known = read_manifest(out) or _legacy(out)
+    kind, files = known if known else (None, set())
+    ours = {n for n in present if _ours(n, files)}
+    return (kind if ours - {MANIFEST, *HIDDEN} or known and MANIFEST in present else None,
+            ours, present - ours)
+
+
+def _listing(names, limit=4) -> str:
+    names = sorted(names)
+    return ", ".join(names[:limit]) + (f" and {len(names) - limit} more" if len(names) > limit
+                                       else "")
+
+
+def claim_folder(out, kind, planned, restart, overwrite, comm, description=None, apply=True):
+    """The folder rules of ``run`` and ``converge``, before any work (rank 0 decides, every
+    rank gets the answer): a folder holding the other kind is refused; one holding the same
+    kind is refused unless ``restart`` (kept) or ``overwrite`` (exactly the files its
+    manifest lists are removed); files the package did not write are never touched: a folder
+    holding such files and no manifest is refused, and so is one where a file the package is
+    about to write (``planned``, names) exists without being the package's. Then the manifest
+    lists ``planned`` (and what a restart keeps). Returns True when an earlier run/study of
+    this kind is there (before any overwrite). Raises InputError. ``apply`` False: the checks
+    alone (nothing removed, no manifest written)."""
+    result = None
     if comm.rank == 0:
-        for path in [out / name for name in RUN_FILES] + list(out.glob("fields*.xdmf")) + \
-                list(out.glob("fields*.h5")) + list(out.glob("fields*.xdmf.bak")):
-            if path.exists():
+        try:
+            result = _claim(Path(out), kind, set(planned), restart, overwrite, description,
+                            apply)
+        except InputError as exc:
+            result = exc
+        except OSError as exc:
+            result = InputError(f"cannot use {str(out)!r}: {exc.strerror or exc}")
+    result = comm.bcast(result, root=0)
+    if isinstance(result, InputError):
+        raise result
+    return result
+
+
+def _claim(out, kind, planned, restart, overwrite, description, apply=True):
+    found, ours, others = folder_contents(out)
+    other_kind = {"run": "study", "study": "run"}[kind]
+    what = {"run": "a run", "study": "a convergence study"}
+    if found == other_kind:
+        raise InputError(f"{str(out)!r} holds {what[other_kind]}; {what[kind]} needs a folder "
+                         "of its own: choose another --out (nothing was touched)")
+    earlier = found == kind and bool(ours - {MANIFEST, *HIDDEN})
+    if others and found is None:
+        raise InputError(f"{str(out)!r} holds files damage-dolfinx did not write "
+                         f"({_listing(others)}) and no {MANIFEST}: choose another --out or an "
+                         "empty folder (nothing was touched)")
+    clash = others & {n for p in planned for n in (p, p + ".tmp")}
+    if clash:
+        raise InputError(f"{str(out)!r} holds {_listing(clash)}, not written by damage-dolfinx "
+                         f"(not in its {MANIFEST}), where this {kind} would write: move "
+                         "them or choose another --out (nothing was touched)")
+    if earlier and not restart and not overwrite:
+        raise InputError(f"{str(out)!r} holds {description or what[kind]}; --restart "
+                         "continues it, --overwrite replaces it, or choose another --out")
+    if not apply:
+        return earlier
+    keep = set()
+    if earlier and overwrite and not restart:
+        for name in sorted(ours - {MANIFEST, *HIDDEN}):
+            path = out / name
+            if path.is_file() or path.is_symlink():
                 path.unlink()
+    elif earlier:
+        keep = ours - set(HIDDEN)
+    write_manifest(out, kind, keep | planned)
+    return earlier
+
+
+def write_manifest(out, kind, files):
+    from damage_dolfinx.runtime.atomic import write_json
+    write_json(Path(out) / MANIFEST, {"schema": MANIFEST_SCHEMA, "kind": kind,
+                                      "files": sorted(set(files) - {MANIFEST, *HIDDEN})},
+               MPI.COMM_SELF)
+
+
+def add_to_manifest(out, names, comm):
+    """List ``names`` in ``out``'s manifest before they are written (rank 0)."""
+    if comm.rank != 0:
+        return
+    known = read_manifest(out)
+    if known is None:
+        return
+    kind, files = known
+    if not set(names) <= files:
+        write_manifest(out, kind, files | set(names))
+
+
+# ---------------------------------------------------------------------------- mesh files
+def check_mesh_file(path, dim, required_tags=(), comm=MPI.COMM_WORLD):
+    """A gmsh .msh file is readable, holds cells of topological dimension ``dim`` and facet
+    (dimension dim - 1) physical tags including every one of ``required_tags``; raises
+    InputError with one line naming the file and what is wrong (rank 0 reads, all ranks
+    raise). Read by gmsh's own reader, outside any DOLFINx call. ``required_tags`` may be a
+    callable returning them (evaluated on rank 0 only, after the file itself passed)."""
+    error = _mesh_problem(Path(path), dim, required_tags) if comm.rank == 0 else None
+    error = comm.bcast(error, root=0)
+    if error:
+        raise InputError(f"mesh file {str(path)!r}: {error}")
+
+
+def _mesh_problem(path, dim, required):
+    if not path.is_file():
+        return "does not exist"
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as f:
+            head = f.read(64)
+    except OSError as exc:
+        return f"cannot be read ({exc.strerror or exc})"
+    if size == 0:
+        return "is empty"
+    if not head.lstrip().startswith(b"$MeshFormat"):
+        return "is not a gmsh .msh file (no $MeshFormat header)"
+    gmsh = _gmsh()
+    gmsh.model.add("check_mesh_file")
+    try:
+        try:
+            gmsh.merge(str(path))
+        except Exception as exc:  # noqa: BLE001 - gmsh raises a bare Exception
+            return f"gmsh cannot read it ({str(exc).splitlines()[0] if str(exc) else 'error'})"
+        got = gmsh.model.getDimension()
+        if got != dim or len(gmsh.model.mesh.getElementTypes(dim)) == 0:
+            return f"holds a {got}-D mesh, this example needs a {dim}-D one"
+        if not gmsh.model.getPhysicalGroups(dim):
+            return f"has no physical group of dimension {dim} (the cells)"
+        tags = {t for _, t in gmsh.model.getPhysicalGroups(dim - 1)}
+    finally:
+        gmsh.model.remove()
+    required = required() if callable(required) else required
+    missing = sorted(set(required) - tags)
+    if missing:
+        return (f"lacks the boundary tags {missing} this example needs (has "
+                f"{sorted(tags) or 'none'}; 1 = Gamma_D, 2 = Gamma_N, 3 = Gamma_C)")
+    return None
+
+
+def _gmsh():
+    """The gmsh module, initialised (gmsh 4.8 has no isInitialized; DOLFINx's reader finalises
+    gmsh after reading a file, behind geometries.gmsh_session's back)."""
+    import os
+    from damage_dolfinx.geometries import gmsh_session
+    gmsh = gmsh_session()
+    saved = os.dup(2)  # gmsh prints "not initialized" itself before raising
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 2)
+        os.close(devnull)
+        try:
+            gmsh.model.getCurrent()
+        except Exception:  # noqa: BLE001 - finalised: start it again
+            gmsh.initialize()
+            gmsh.option.setNumber("General.Terminal", 0)
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+    return gmsh

@@ -35,7 +35,8 @@ from damage_dolfinx.viz import post
 from damage_dolfinx.numerics.damage import fast_path_counts
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx.runtime.runfolder import RunLock, previous_run, remove_run_files
+from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
+                                              claim_folder, previous_run)
 from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
 from damage_dolfinx.numerics.solvers import ConvergenceError
 
@@ -65,6 +66,58 @@ class Progress:
 
 #: default wall-time interval between checkpoints (seconds)
 CHECKPOINT_SECONDS = 120.0
+#: zeta may leave [zeta_star, 1] by this much (solver tolerance) before the run is stopped,
+#: where the damage step imposes the bounds (the obstacle step of most models)
+STATE_TOLERANCE = 1e-6
+#: the same for a damage step in PDE form (2.1, 2.3: the scheme imposes no bound, zeta may
+#: overshoot 1 by discretisation, e.g. 3.7e-6 for 2.1-ex1 at n = 10, and the step that reaches
+#: zeta_star, which ends the run by design, may pass below it): only a departure of the order
+#: of the whole range is absurd
+PDE_STATE_MARGIN = 1.0
+
+
+#: exceptions a solver step can raise besides ConvergenceError (PETSc errors, our own
+#: factorisations' RuntimeError, arithmetic on broken numbers)
+SOLVER_EXCEPTIONS = (RuntimeError, ArithmeticError, ValueError, np.linalg.LinAlgError)
+
+
+def solver_step(fn, where):
+    """``fn()``, any solver exception turned into one-line ConvergenceError naming ``where``."""
+    from petsc4py import PETSc
+    try:
+        return fn()
+    except (ConvergenceError, InputError):
+        raise
+    except (PETSc.Error, *SOLVER_EXCEPTIONS) as exc:
+        text = next((line.strip() for line in reversed(str(exc).splitlines())
+                     if line.strip() and "() at " not in line), type(exc).__name__)
+        raise ConvergenceError(f"{where}: {type(exc).__name__}: {text.lstrip('[0123456789] ')}"
+                               ) from exc
+
+
+def state_problem(stepper, tolerance=None):
+    """What is wrong with the stepper's owned values (NaN/Inf in u or zeta, zeta outside
+    [zeta_star - tol, 1 + tol]; tol STATE_TOLERANCE, or PDE_STATE_MARGIN for a damage step in
+    PDE form) on this rank, as (code, detail): code 0 (fine), 1 (non-finite), 2 (zeta out of
+    range). Owned arrays, NumPy only."""
+    zeta_star = stepper.params.zeta_star
+    if tolerance is None:
+        bounded = getattr(getattr(stepper, "damage", None), "obstacle", True)
+        tolerance = STATE_TOLERANCE if bounded else PDE_STATE_MARGIN
+    for name in ("u", "zeta"):
+        f = getattr(stepper, name, None)
+        if f is None:
+            continue
+        V = f.function_space
+        values = f.x.array[:V.dofmap.index_map.size_local * V.dofmap.index_map_bs]
+        if not np.isfinite(values).all():
+            return 1, f"{name} is not finite (NaN or Inf)"
+        if name == "zeta" and values.size:
+            lo, hi = float(values.min()), float(values.max())
+            if lo < zeta_star - tolerance or hi > 1.0 + tolerance:
+                return 2, (f"zeta left [zeta_star, 1] = [{zeta_star:g}, 1] by more than "
+                           f"{tolerance:g}: min {lo:.6g}, max {hi:.10g}")
+    return 0, ""
 
 
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
@@ -90,7 +143,13 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     the last and a stopping step. In between, the stepper only updates what summary.json reports
     over all steps (``stepper.track()``: the 3.3 maximal interpenetration, its time and place;
     a stepper without it computes its scalars), and the summary's other scalars are brought up
-    to date before each output, checkpoint or stop."""
+    to date before each output, checkpoint or stop.
+
+    Refused before any work (InputError): cadences below 1, a ``mesh_file`` that is not a readable mesh of the example's dimension
+    with its boundary tags (runfolder.check_mesh_file), and a folder the run may not write
+    into (runfolder.claim_folder: the manifest). A NaN, an infinity or a zeta outside
+    [zeta_star, 1] (beyond STATE_TOLERANCE) in a field, and every exception of a solver, end
+    the run as a ConvergenceError with status "failed" in summary.json."""
     ex = resolve(example_id, overrides)
     configured = ex.configure(n, k, T, h, overrides, mesh_file)
     every = history_every if history_every is not None else \
@@ -99,6 +158,16 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
             or every < 1:
         raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
     every = int(every)
+    for name, value in (("--write-every", write_every), ("--checkpoint-every", checkpoint_every)):
+        if value is not None and (isinstance(value, bool) or not isinstance(value, int)
+                                  or value < 1):
+            raise InputError(f"{name} must be a whole number >= 1, got {value!r}")
+    if not (isinstance(checkpoint_seconds, (int, float)) and checkpoint_seconds >= 0
+            and math.isfinite(checkpoint_seconds)):
+        raise InputError(f"--checkpoint-seconds must be a finite number >= 0 (0: none), got "
+                         f"{checkpoint_seconds!r}")
+    if mesh_file is not None:
+        check_mesh_file(mesh_file, ex.dim, lambda: ex.mesh_requirements()[1], comm=comm)
     if restart and not Path(out).is_dir():
         raise InputError(f"cannot restart: no checkpoint in {str(out)!r} (no such folder)")
     out = io.prepare_output_dir(out, comm)
@@ -133,7 +202,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     previous = previous_run(out, comm)
     resume = None
     if restart:
-        resume = checkpoint.resume_point(out, settings, grid, previous, comm)
+        resume = checkpoint.resume_point(out, settings, grid, previous, comm,
+                                         parameters=params.as_dict())
         if resume is None:
             if comm.rank == 0:
                 print(f"damage-dolfinx: nothing to do: the run in {str(out)!r} ended "
@@ -142,19 +212,24 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                       + (" (a larger --T continues it)" if previous["status"] == "completed"
                          else ""), flush=True)
             return previous
-    elif previous:
-        if not overwrite:
-            raise InputError(f"{str(out)!r} holds {previous['description']}; --restart continues "
-                             "it, --overwrite replaces it, or choose another --out")
-        io.collective(comm, out, f"(remove) the previous run in {out}", remove_run_files, out,
-                      comm)
+    xdmf_name = f"fields_from_step{resume[1]['step']}.xdmf" if resume else "fields.xdmf"
+    planned = {"summary.json", "history.csv", xdmf_name, xdmf_name[:-5] + ".h5",
+               xdmf_name + ".bak", "fields_final.npz", "checkpoint.json",
+               *checkpoint.GENERATIONS, *(fig.filename for fig in ex.figures if figures)}
+    description = previous["description"] if previous else None
+    claim_folder(out, "run", planned, restart, overwrite, comm, description, apply=False)
     path, resume = resume or (None, None)
     if resume:
         repaired = comm.bcast(io.repair_xdmf(out) if comm.rank == 0 else None)
         if repaired and comm.rank == 0:
             print(f"damage-dolfinx: {', '.join(repaired)} restored to its last complete output "
                   "time (the run was killed while writing it)", file=sys.stderr, flush=True)
-    stepper = ex.build(comm, n, k, T, h, overrides, mesh_file)
+    try:  # before any step: a solver that cannot be set up is refused input (PETSc options)
+        stepper = solver_step(lambda: ex.build(comm, n, k, T, h, overrides, mesh_file),
+                              "cannot set up the solvers")
+    except ConvergenceError as exc:
+        raise InputError(str(exc)) from None
+    claim_folder(out, "run", planned, restart, overwrite, comm, description)
     if (resume or checkpoint_every) and not stepper.checkpoint_supported:
         raise InputError(f"example {ex.id} does not support checkpoints")
     supported = stepper.checkpoint_supported
@@ -178,7 +253,6 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                "outputs": {"xdmf": "fields.xdmf", "history": "history.csv",
                            "final_fields": "fields_final.npz", "figures": []},
                "environment": io.environment(comm)}
-    xdmf_name = f"fields_from_step{resume['step']}.xdmf" if resume else "fields.xdmf"
     summary["outputs"]["xdmf"] = xdmf_name
     files = {}  # the XDMF series and the history, created below (collectively checked)
     columns = ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
@@ -209,7 +283,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     def save_checkpoint():
         write_summary()  # first: the summary is never behind the checkpoint
         checkpoint.save(out, stepper.checkpoint_state(), {
-            **settings, "step": stepper.n, "t": stepper.t, "mpi_size": comm.size,
+            **settings, "parameters": summary["parameters"], "step": stepper.n,
+            "t": stepper.t, "mpi_size": comm.size,
             "wall_time_s": previous_wall + time.perf_counter() - wall_start,
             "restarts": summary.get("restarts", [])}, comm)
         last_checkpoint.update(time=time.perf_counter(), step=stepper.n)
@@ -218,13 +293,25 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         """One allreduce per step: seconds since the last checkpoint and since the start, the
         signal received (if any) and whether the history row failed, agreed by all ranks."""
         now = time.perf_counter()
+        bad, detail = state_problem(stepper)
         state = np.array([now - last_checkpoint["time"], now - wall_start, signals.signum,
-                          float(history.error is not None)])
+                          float(history.error is not None), bad])
         comm.Allreduce(MPI.IN_PLACE, state, op=MPI.MAX)
         if state[3]:
             reason = comm.bcast(io.describe(history.error, out) if comm.rank == 0 else None)
             raise io.OutputError(f"cannot write {at('history.csv')}: {reason}")
+        if state[4]:
+            check_state()  # raises (the detail from a rank that has it)
         return state[0], state[1], int(state[2])
+
+    def check_state():
+        """Stop on a NaN/Inf or a zeta outside [zeta_star, 1] on any rank (collective)."""
+        bad, detail = state_problem(stepper)
+        ranks = comm.allgather(detail if bad else None)
+        detail = next((d for d in ranks if d), None)
+        if detail:
+            raise ConvergenceError(f"{at('the state')}: {detail}; the run is stopped (the "
+                                   "model or its data gave numbers that cannot be right)")
 
     def checkpoint_due(since_checkpoint) -> bool:
         if not supported:
@@ -261,6 +348,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
 
     def figure(fig, suffix=""):
         def draw():
+            add_to_manifest(out, [fig.filename.replace(".png", f"{suffix}.png")], comm)
             summary["outputs"]["figures"].append(draw_figure(ex, fig, stepper, out, suffix))
         io.collective(comm, out, at(fig.filename), draw)
 
@@ -288,10 +376,12 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         if resume:
             checkpoint.load(path, stepper.checkpoint_state())
             stepper.restore(resume["step"])
+            check_state()
             stats, scalars = {}, stepper.scalars()
             write_fields()
         else:
-            stats = stepper.initialize()
+            stats = solver_step(stepper.initialize, at("the initial solve"))
+            check_state()
             scalars = record(stats, time.perf_counter() - start)
             write_fields()
             timed_figures()
@@ -299,7 +389,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         stop = None
         while stepper.n < N:
             start = time.perf_counter()
-            stats = stepper.advance()
+            stats = solver_step(stepper.advance, f"step {stepper.n + 1} (t = "
+                                                 f"{stepper.t + grid.k:.6g})")
             step_time = time.perf_counter() - start
             row = stepper.n % history_every == 0 or stepper.n == N
             if row:

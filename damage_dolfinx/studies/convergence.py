@@ -18,6 +18,8 @@ fitted rate) and ``summary.json``.
 """
 from __future__ import annotations
 
+import json
+import sys
 import time
 
 import numpy as np
@@ -28,7 +30,10 @@ from damage_dolfinx.catalogue import examples
 from damage_dolfinx.runtime import io
 from damage_dolfinx.viz import post
 from damage_dolfinx.parameters import InputError, TimeGrid
-from damage_dolfinx.runtime.runner import Progress
+from damage_dolfinx.runtime.runner import Progress, solver_step
+from damage_dolfinx.numerics.solvers import ConvergenceError
+
+SCHEMA = "damage-dolfinx/convergence/v1"
 
 
 class _CoarseRun:
@@ -74,7 +79,8 @@ class _CoarseRun:
 
     def advance(self, initial=False):
         start = time.perf_counter()
-        self.stepper.initialize() if initial else self.stepper.advance()
+        solver_step(self.stepper.initialize if initial else self.stepper.advance,
+                    f"cell n = {self.n}, k = {self.k:g}, step {self.stepper.n + 1}")
         self.wall += time.perf_counter() - start
 
     def measure(self):
@@ -163,7 +169,22 @@ def _error_definition(components) -> str:
     return "max_n (" + " + ".join(label[norm].format(name) for name, _, norm in components) + ")"
 
 
+def _check_levels(ref_n, ref_k, ns, ks):
+    """Levels are positive, distinct and of the right type (before any division by them)."""
+    for name, values, kind in (("--ref-n", [ref_n], int), ("--n", ns, int),
+                               ("--ref-k", [ref_k], float), ("--k", ks, float)):
+        for v in values:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0 or \
+                    (kind is int and v != int(v)) or v != v or v == float("inf"):
+                raise InputError(f"{name}: every level must be a positive "
+                                 f"{'whole ' if kind is int else 'finite '}number, got {v!r}")
+        if len(set(values)) != len(values):
+            raise InputError(f"{name}: the levels must be distinct, got "
+                             f"{' '.join(f'{v:g}' for v in values)}")
+
+
 def _check_nested(ref_n, ref_k, ns, ks):
+    _check_levels(ref_n, ref_k, ns, ks)
     for n in ns:
         if ref_n % n:
             raise InputError(f"coarse mesh n = {n} is not nested in the reference n = {ref_n}")
@@ -177,7 +198,7 @@ def _check_nested(ref_n, ref_k, ns, ks):
 
 def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, overrides=None,
           progress=True, comm=MPI.COMM_WORLD, serial_max_n=SERIAL_CELL_MAX_N,
-          reference_ranks=None) -> dict:
+          reference_ranks=None, restart=False, overwrite=True) -> dict:
     """Run the study; returns the summary (errors per (n, k), fitted rates, wall times).
 
     ``reference_ranks`` (default: the catalogue's ``convergence["reference_ranks"]``, else 1):
@@ -187,7 +208,13 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     is faster for every thesis study (benchmarks/README.md): a serial step uses
     PETSc's Cholesky and the serial-only zeta-linear matrices of 3.3, MUMPS on 2 ranks is no
     faster than that, and the second rank is free for the cells. A finer reference on many
-    ranks wants "all"."""
+    ranks wants "all".
+
+    The folder follows the rules of a run (runfolder.claim_folder, manifest.json): a folder
+    holding a run is refused, one holding a study unless ``overwrite`` (its listed files are
+    replaced) or ``restart`` (nothing to do when it completed with these settings; studies keep
+    no checkpoints, so an unfinished one runs again). A solver failure or a non-finite error
+    leaves summary.json with status "failed" and the error."""
     wall_start = time.perf_counter()
     from damage_dolfinx.runtime.runner import resolve
     ex = resolve(example_id, overrides)
@@ -199,17 +226,83 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     if ex.n is None:
         raise InputError(f"example {example_id} has no nested structured meshes; "
                          "convergence studies need one (e.g. 2.1-ex1)")
-    ref_n = ref_n or defaults["ref_n"]
-    ref_k = ref_k or defaults["ref_k"]
-    ns, ks = list(ns or defaults["n"]), list(ks or defaults["k"])
-    T = T or ex.T
+    ref_n = defaults["ref_n"] if ref_n is None else ref_n  # 0 is refused, not the default
+    ref_k = defaults["ref_k"] if ref_k is None else ref_k
+    ns = list(defaults["n"] if ns is None else ns)
+    ks = list(defaults["k"] if ks is None else ks)
+    T = ex.T if T is None else T
     _check_nested(ref_n, ref_k, ns, ks)
     for n in ns + [ref_n]:
         ex.configure(n=n, k=ref_k, T=T, overrides=overrides)
     for k in ks:
         TimeGrid(k, T)
     out = io.prepare_output_dir(out, comm)
+    settings = {"example": ex.id, "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k,
+                "T": T, "n": ns, "k": ks,
+                "parameters": json.loads(io.strict_json(
+                    ex.configure(n=ref_n, k=ref_k, T=T, overrides=overrides)[0].as_dict()))}
+    previous = _previous_study(out, comm)
+    if restart and previous is not None and previous.get("status") == "completed":
+        differ = [key for key in settings if previous.get(key) != settings[key]]
+        if not differ:
+            if comm.rank == 0:
+                print(f"damage-dolfinx: nothing to do: the study in {str(out)!r} completed "
+                      "with these settings; its outputs are unchanged", flush=True)
+            return previous
+        raise InputError(f"cannot restart: the study in {str(out)!r} has {differ[0]} = "
+                         f"{previous.get(differ[0])!r}, this study {settings[differ[0]]!r}")
+    from damage_dolfinx.runtime.runfolder import STUDY_FILES, RunLock, claim_folder
+    lock = RunLock(out, comm)
+    try:
+        earlier = claim_folder(out, "study", STUDY_FILES, restart, overwrite, comm,
+                               "a convergence study", apply=False)
+        if earlier and restart and comm.rank == 0:
+            print(f"damage-dolfinx: the study in {str(out)!r} did not complete and studies keep "
+                  "no checkpoints: it runs again from the start", file=sys.stderr, flush=True)
+        claimed = []
 
+        def claim():  # after the set-up: a refused one leaves the folder untouched
+            claim_folder(out, "study", STUDY_FILES, restart, overwrite, comm,
+                         "a convergence study")
+            claimed.append(True)
+        return _study(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, serial_max_n,
+                      reference_ranks, defaults, wall_start, settings, claim, claimed)
+    finally:
+        lock.release()
+
+
+def _previous_study(out, comm):
+    """The summary.json of a study in ``out`` (None: none, or not a study's)."""
+    result = None
+    if comm.rank == 0:
+        try:
+            result = json.loads((out / "summary.json").read_text())
+        except (OSError, ValueError):
+            result = None
+        if not isinstance(result, dict) or result.get("schema") != SCHEMA:
+            result = None
+    return comm.bcast(result, root=0)
+
+
+def _study(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, serial_max_n,
+           reference_ranks, defaults, wall_start, settings, claim, claimed):
+    failed = {"schema": SCHEMA, "status": "failed", **settings}
+    try:
+        return _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm,
+                         serial_max_n, reference_ranks, defaults, wall_start, settings, claim)
+    except (ConvergenceError, InputError) as exc:
+        if not claimed:
+            raise
+        failed.update(error=str(exc), wall_time_s=time.perf_counter() - wall_start)
+        try:
+            io.write_json(out / "summary.json", failed, comm)
+        except OSError:
+            pass
+        raise
+
+
+def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, serial_max_n,
+              reference_ranks, defaults, wall_start, settings, claim):
     ref_serial = comm.size > 1 and (reference_ranks or defaults.get("reference_ranks", 1)) == 1
     ref_rank, ref_comm = (0, MPI.COMM_SELF) if ref_serial else (None, comm)
     ref = ex.build(ref_comm, n=ref_n, k=ref_k, T=T, overrides=overrides) \
@@ -240,11 +333,12 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     for run in runs:
         run.connect(ref, *geometry[(run.n, run.k)], transfers, norms, ref_comm, ref_rank, comm,
                     outbox)
+    claim()
     num_steps = comm.bcast(ref.num_steps if comm.rank == 0 else None, root=0)
     report = Progress(f"{ex.id} converge", num_steps, comm, enabled=progress, interval=10.0)
 
     ref_wall = time.perf_counter()
-    stats = ref.initialize() if ref is not None else {}
+    stats = solver_step(ref.initialize, "the reference, initial solve") if ref is not None else {}
     ref_wall = time.perf_counter() - ref_wall
     for run in runs:
         if run.mine:
@@ -255,7 +349,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     while step < num_steps:
         start = time.perf_counter()
         if ref is not None:
-            stats = ref.advance()
+            stats = solver_step(ref.advance, f"the reference, step {step + 1}")
         ref_wall += time.perf_counter() - start
         step += 1
         due = [run for run in runs if step % run.ratio == 0]
@@ -289,12 +383,22 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     rows = [{"n": r.n, "h": r.h, "k": r.k, "h_plus_k": r.h + r.k, "error": r.err,
              **{f"error_{name}_{norm}": r.err_parts[name] for name, _, norm in components},
              "error_at_T": r.err_T, "wall_time_s": r.wall} for r in runs]
+    for r in rows:
+        if not all(np.isfinite(v) for key, v in r.items() if key.startswith("error")):
+            raise ConvergenceError(f"the error of the cell n = {r['n']}, k = {r['k']:g} is not "
+                                   "finite: a run of the study gave numbers that cannot be right")
     rates = fitted_rates(rows, ns, ks)
     rates_T = fitted_rates(rows, ns, ks, key="error_at_T")
-    summary = {"schema": "damage-dolfinx/convergence/v1", "example": ex.id, "title": ex.title,
+    summary = {"schema": SCHEMA, "status": "completed", **settings, "example": ex.id,
+               "title": ex.title,
                "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
                "error_definition": definition,
-               "errors": rows, "rates": rates, "rates_at_T": rates_T, "mpi_size": comm.size,
+               "errors": rows, "rates": rates, "rates_at_T": rates_T,
+               **({"rates_note": "a rate without a value (null) needs two or more levels that "
+                                 "differ in it"}
+                  if not all(np.isfinite(v) for v in (*rates.values(), *rates_T.values())
+                             if isinstance(v, float)) else {}),
+               "mpi_size": comm.size,
                "serial_cells": {"max_n": (max(ns) if ref_serial else serial_max_n)
                                 if comm.size > 1 else None,
                                 "rank_of_cell": [[r.n, r.k, r.owner] for r in runs]},

@@ -1,0 +1,83 @@
+"""The fast cases of the bad-input table (benchmarks/faults/bad_inputs.py), in this process:
+each is refused before any work (one line, exit status 2, no file written or changed), fails
+with its documented status (3, summary.json "failed") or warns, as the table expects; no
+traceback, no file of the user's touched. And every JSON file of a run and of a study parses
+with a strict parser (no bare NaN or Infinity)."""
+import contextlib
+import importlib.util
+import io
+import json
+import os
+import traceback
+from pathlib import Path
+
+import pytest
+
+from damage_dolfinx import cli
+
+ROOT = Path(__file__).resolve().parents[1]
+_spec = importlib.util.spec_from_file_location("bad_inputs",
+                                               ROOT / "benchmarks" / "faults" / "bad_inputs.py")
+bad_inputs = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(bad_inputs)
+
+FAST = [c for c in bad_inputs.CASES if c["fast"]]
+
+
+def in_process(args, cwd):
+    """(exit status, stdout, stderr) of cli.main(args) run in ``cwd``; an exception that
+    escapes is written to stderr as a traceback (the table counts it as such)."""
+    out, err = io.StringIO(), io.StringIO()
+    here = os.getcwd()
+    os.chdir(cwd)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                status = cli.main([str(a) for a in args])
+            except SystemExit as exc:
+                status = exc.code
+            except Exception:  # noqa: BLE001 - recorded, not raised
+                err.write(traceback.format_exc())
+                status = 1
+    finally:
+        os.chdir(here)
+    return status, out.getvalue(), err.getvalue()
+
+
+@pytest.fixture(scope="module")
+def bases(tmp_path_factory):
+    root = tmp_path_factory.mktemp("bases")
+
+    def runner(args, cwd):
+        status, _, err = in_process(args, cwd)
+        assert status == 0, err
+    return bad_inputs.make_bases(root, runner)
+
+
+@pytest.mark.parametrize("case", FAST, ids=[c["id"] for c in FAST])
+def test_bad_input(case, bases, tmp_path):
+    result = bad_inputs.run_case(case, bases, tmp_path, runner=in_process)
+    assert result["pass"], json.dumps(result, indent=1)
+
+
+def _strict_files(folder):
+    names = sorted(Path(folder).rglob("*.json"))
+    assert names
+    for path in names:
+        bad_inputs._strict(path.read_text())  # raises on a bare NaN / Infinity
+    return [p.name for p in names]
+
+
+def test_every_json_of_a_run_and_a_study_is_strict(bases):
+    assert {"summary.json", "manifest.json", "checkpoint.json"} <= set(_strict_files(bases["run"]))
+    assert {"summary.json", "manifest.json"} <= set(_strict_files(bases["study"]))
+
+
+def test_one_level_study_writes_null_rates_with_a_reason(tmp_path):
+    status, _, err = in_process(["converge", "2.1-ex1", "--ref-n", "10", "--ref-k", "0.125",
+                                 "--n", "5", "--k", "0.25", "--quiet", "--out", "o"], tmp_path)
+    assert status == 0, err
+    _strict_files(tmp_path / "o")
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["rates"]["h_plus_k_all"] is None
+    assert summary["null_values"]["rates.h_plus_k_all"] == "NaN" and "rates_note" in summary
