@@ -1,4 +1,5 @@
-"""Command line: ``damage-dolfinx list | run ID | converge ID`` (works unchanged under mpirun).
+"""Command line: ``damage-dolfinx list | run ID | converge ID | sweep ID`` (works unchanged under
+mpirun).
 
 Single-dash options are PETSc options of the package's solvers (``-mech_ksp_type cg``,
 ``-damage_snes_monitor``; prefixes PETSC_PREFIXES): any other single-dash word is refused with
@@ -100,7 +101,58 @@ def _parser():
                            "settings, else it runs again (studies keep no checkpoints)")
     conv.add_argument("--overwrite", action="store_true",
                       help="replace a study already in --out: the files its manifest.json lists")
+    _sweep_parser(sub)
     return p
+
+
+def _sweep_parser(sub):
+    """The ``sweep`` subcommand: one example or mesh over a grid of parameter values."""
+    sw = sub.add_parser("sweep", help="run an example over a grid of parameter values",
+                        allow_abbrev=False,
+                        description="Run an example at every point of a parameter grid (the "
+                                    "product of the --set lists), each point a run folder "
+                                    "OUT/point_<i>, shared out among the MPI ranks; a sweep run "
+                                    "again keeps its finished points. Writes OUT/points.json, "
+                                    "OUT/sweep.csv (every point's final scalars) and "
+                                    "OUT/sweep.png.")
+    sw.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`)")
+    sw.add_argument("--set", action="append", default=[], metavar="NAME=V1,V2,...",
+                    help="a swept parameter and its values, e.g. --set kappa=0.01,0.1,1 "
+                         "(repeatable; one value fixes the parameter)")
+    sw.add_argument("--out", required=True, help="sweep folder")
+    sw.add_argument("--n", type=int, help="cells per side (structured meshes), every point")
+    sw.add_argument("--k", type=float, help="time step, every point")
+    sw.add_argument("--T", type=float, help="final time, every point")
+    sw.add_argument("--restart", action="store_true",
+                    help="resume interrupted points from their checkpoints (without it they "
+                         "rerun from the start); finished points are always kept")
+    sw.add_argument("--max-points", type=int, metavar="N",
+                    help="run at most N of the unfinished points, then stop")
+    sw.add_argument("--plot", default="zeta_min", metavar="SCALAR",
+                    help="final scalar drawn against the swept parameters (default zeta_min)")
+    sw.add_argument("--no-figures", action="store_true", help="no PNG figures per point")
+    sw.add_argument("--quiet", action="store_true", help="no progress lines")
+
+
+def _sweep(args):
+    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.studies.sweep import parse_values, sweep
+    if not args.set:
+        raise InputError("sweep needs at least one --set NAME=V1,V2,...")
+    grid = {}
+    for pair in args.set:
+        if "=" not in pair:
+            raise InputError(f"--set expects NAME=V1,V2,..., got {pair!r}")
+        name, values = (part.strip() for part in pair.split("=", 1))
+        if not name:
+            raise InputError(f"--set {pair!r}: no parameter name")
+        if name in grid:
+            raise InputError(f"--set {name}: the parameter is given twice")
+        grid[name] = parse_values(values, name) if values else []
+    sweep(args.id, args.out, grid, n=args.n, k=args.k, T=args.T, restart=args.restart,
+          max_points=args.max_points, plot=args.plot, figures=not args.no_figures,
+          progress=not args.quiet)
+    return 0
 
 
 #: prefixes of the package's PETSc solvers (an option -<prefix><name> reaches one of them)
@@ -285,6 +337,8 @@ def main(argv=None):
                        figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
                        checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
                        overwrite=args.overwrite, history_every=args.history_every)
+        elif args.command == "sweep":
+            _sweep(args)
         elif args.command == "converge":
             from damage_dolfinx.studies import convergence
             convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
