@@ -14,7 +14,8 @@ the nested reference mesh and measured there:
    + \|\zeta_{\mathrm{ref}} - \zeta_{hk}\|_{L^2}\Bigr)(t_n),
    \qquad \|v\|_V = \|\varepsilon(v)\|_{L^2}.
 
-Piecewise linear elements and the implicit Euler steps of the models are of first order: :math:`e \approx C (h + k)`.
+Piecewise linear elements and the implicit Euler steps of the models are of first order:
+:math:`e \approx C (h + k)`.
 
 What to take away: how to write a mesh family ``(comm, n) -> mesh`` of nested meshes, run the
 study, and read the fitted rate.
