@@ -159,9 +159,9 @@ def test_gmsh_file_through_the_cli(tmp_path):
 
 
 @pytest.mark.parametrize("case, expected", [
-    ("untagged", "no physical curve tags the boundary"),
+    ("untagged", "lacks the boundary tags"),
     ("empty", "is empty"),
-    ("text", "expected a gmsh .msh file"),
+    ("text", "is not a gmsh .msh file"),
     ("garbage", "gmsh cannot read it"),
     ("3d", "3-D mesh"),
 ])
