@@ -31,96 +31,20 @@ from mpi4py import MPI
 
 from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.catalogue import examples
-from damage_dolfinx.viz import post
 from damage_dolfinx.numerics.damage import fast_path_counts
 from damage_dolfinx.parameters import InputError
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
                                               claim_folder, previous_run)
 from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
 from damage_dolfinx.numerics.solvers import ConvergenceError
 
 
-class Progress:
-    """Rank-0 progress lines, at most one every ``interval`` seconds (plus first and last)."""
-
-    def __init__(self, label, total, comm, enabled=True, interval=2.0):
-        self.label, self.total, self.enabled = label, total, enabled and comm.rank == 0
-        self.interval, self.start, self.last = interval, time.perf_counter(), -math.inf
-
-    def __call__(self, step, t, stats, scalars, force=False):
-        """``scalars``: the step's scalars, or a callable returning them (asked only when a line
-        is printed)."""
-        now = time.perf_counter()
-        if not self.enabled or (not force and now - self.last < self.interval and step != self.total):
-            return
-        self.last = now
-        if callable(scalars):
-            scalars = scalars()
-        elapsed = now - self.start
-        eta = elapsed / max(step, 1) * (self.total - step)
-        its = " ".join(f"{k}={v}" for k, v in stats.items())
-        print(f"[{self.label}] step {step}/{self.total} t={t:.5g} {its} "
-              f"min zeta={scalars['zeta_min']:.4f} ({elapsed:.1f} s, ETA {eta:.0f} s)", flush=True)
-
+from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  # noqa: F401
+                                           Progress, solver_step, state_problem)
+from damage_dolfinx.runtime.figures import auto_amplification, draw_figure  # noqa: F401
 
 #: default wall-time interval between checkpoints (seconds)
 CHECKPOINT_SECONDS = 120.0
-#: zeta may leave [zeta_star, 1] by this much (solver tolerance) before the run is stopped,
-#: where the damage step imposes the bounds (the obstacle step of most models)
-STATE_TOLERANCE = 1e-6
-#: the same for a damage step in PDE form (2.1, 2.3: the scheme imposes no bound, zeta may
-#: overshoot 1 by discretisation, e.g. 3.7e-6 for 2.1-ex1 at n = 10, and the step that reaches
-#: zeta_star, which ends the run by design, may pass far below it: -1.9 for 2.1-ex1 with
-#: lam_u_plus = 1e8, -1.25 for the literal reading of the arch): only a departure of a hundred
-#: times the whole range is absurd
-PDE_STATE_MARGIN = 100.0
-
-
-#: exceptions a solver step can raise besides ConvergenceError (PETSc errors, our own
-#: factorisations' RuntimeError, arithmetic on broken numbers)
-SOLVER_EXCEPTIONS = (RuntimeError, ArithmeticError, ValueError, np.linalg.LinAlgError)
-
-
-def solver_step(fn, where):
-    """``fn()``, any solver exception turned into one-line ConvergenceError naming ``where``."""
-    from petsc4py import PETSc
-    try:
-        return fn()
-    except (ConvergenceError, InputError):
-        raise
-    except (PETSc.Error, *SOLVER_EXCEPTIONS) as exc:
-        text = next((line.strip() for line in reversed(str(exc).splitlines())
-                     if line.strip() and "() at " not in line), type(exc).__name__)
-        raise ConvergenceError(f"{where}: {type(exc).__name__}: {text.lstrip('[0123456789] ')}"
-                               ) from exc
-
-
-def state_problem(stepper, tolerance=None):
-    """What is wrong with the stepper's owned values (NaN/Inf in u or zeta, zeta outside
-    [zeta_star - tol, 1 + tol]; tol STATE_TOLERANCE, or PDE_STATE_MARGIN for a damage step in
-    PDE form) on this rank, as (code, detail): code 0 (fine), 1 (non-finite), 2 (zeta out of
-    range). Owned arrays, NumPy only."""
-    zeta_star = stepper.params.zeta_star
-    if tolerance is None:
-        bounded = getattr(getattr(stepper, "damage", None), "obstacle", True)
-        tolerance = STATE_TOLERANCE if bounded else PDE_STATE_MARGIN
-    for name in ("u", "zeta"):
-        f = getattr(stepper, name, None)
-        if f is None:
-            continue
-        V = f.function_space
-        values = f.x.array[:V.dofmap.index_map.size_local * V.dofmap.index_map_bs]
-        if not np.isfinite(values).all():
-            return 1, f"{name} is not finite (NaN or Inf)"
-        if name == "zeta" and values.size:
-            lo, hi = float(values.min()), float(values.max())
-            if lo < zeta_star - tolerance or hi > 1.0 + tolerance:
-                return 2, (f"zeta left [zeta_star, 1] = [{zeta_star:g}, 1] by more than "
-                           f"{tolerance:g}: min {lo:.6g}, max {hi:.10g}")
-    return 0, ""
-
-
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
         write_every=None, progress=True, figures=True, time_limit=None, checkpoint_every=None,
         checkpoint_seconds=CHECKPOINT_SECONDS, restart=False, overwrite=True,
@@ -450,55 +374,3 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
         print(f"[{ex.id}] {summary['status']} at t = {stepper.t:.5g} after {stepper.n} steps in "
               f"{summary['wall_time_s']:.1f} s on {comm.size} rank(s); output in {out}", flush=True)
     return summary
-
-
-def auto_amplification(stepper, diameter) -> float:
-    """The factor that makes the largest displacement 10% of the domain diameter (where the
-    thesis gives none)."""
-    u = stepper.u.x.array.reshape(-1, 2)
-    umax = stepper.comm.allreduce(float(np.max(np.linalg.norm(u, axis=1))) if u.size else 0.0,
-                                  op=MPI.MAX)
-    return 0.1 * diameter / umax if umax > 0 else 1.0
-
-
-def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
-    """One catalogue figure (PNG) of the current state; returns its file entry."""
-    out = Path(out)
-    if stepper.comm.rank == 0:
-        out.mkdir(parents=True, exist_ok=True)
-    stepper.comm.barrier()
-    filename = fig.filename.replace(".png", f"{suffix}.png")
-    if fig.kind == "history":  # history.csv is complete and flushed at the end of the run
-        if stepper.comm.rank == 0:
-            post.plot_history(out / "history.csv", fig.fields, out / filename, title=fig.title)
-        return {"file": filename}
-    if fig.kind == "profiles":  # damage along a line at several times + probe history
-        if stepper.comm.rank == 0:
-            post.plot_damage_profiles(stepper.summary_extra()["profiles"], out / "history.csv",
-                                      stepper.params.zeta_star, out / filename, fig.title)
-        return {"file": filename}
-    if fig.kind == "problem":  # drawn by the stepper (collective): the vault's hinge lines
-        stepper.draw_figure(fig, out / filename)
-        return {"file": filename}
-    if fig.kind == "slices" or stepper.mesh.topology.dim == 3:  # 3-D runs: fields on plane sections (slices.py)
-        from damage_dolfinx.viz.slices import plot_slices
-        planes = plot_slices([(stepper.von_mises, "von Mises stress [Pa]"),
-                              (stepper.zeta, "damage zeta [-]")], out / filename,
-                             title=f"{fig.title} (t = {stepper.t:.4g})",
-                             zeta_star=stepper.params.zeta_star)
-        return {"file": filename, "t": stepper.t, "sections": [list(p) for p in planes]}
-    if fig.kind == "mesh":
-        post.plot_mesh(stepper.data.geometry, out / filename, title=fig.title,
-                       labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",
-                               GAMMA_C: "Gamma_C (contact)"},
-                       loads=post.setting_loads(stepper))
-        return {"file": filename}
-    fields = {"von_mises": (stepper.von_mises, "von Mises stress [Pa]"),
-              "zeta": (stepper.zeta, "damage zeta [-]")}
-    fields.update(getattr(stepper, "figure_fields", {}))  # problem-specific (name: (Function, label))
-    diameter = ex.diameter if ex.diameter == ex.diameter else post.diameter(stepper.mesh)
-    amp = fig.amplification or auto_amplification(stepper, diameter)
-    post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / filename,
-                     amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True,
-                     mesh_lines=fig.mesh_lines)
-    return {"file": filename, "t": stepper.t, "amplification": amp}
