@@ -141,7 +141,7 @@ class Example:
         k_max = quasistatic_k_max(info.id, params)
         if k > k_max:
             from damage_dolfinx.numerics.stability import check_time_step
-            check_time_step(k, k_max, f"{info.explicit}, model {info.id}", action=action)
+            check_time_step(k, k_max, f"{self.id}: {info.explicit}", action=action)
         if n is not None and self.n is None:
             raise InputError(f"example {self.id} uses a gmsh mesh: set its size with --h, not --n")
         if h is not None and self.h is None:

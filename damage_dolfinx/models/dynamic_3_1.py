@@ -144,8 +144,8 @@ class DynamicKelvinVoigt(TimeStepper):
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
                                  bcs=self.bcs, normal=self.n_facet)
-        out["k_over_k_max"] = check_time_step(self.k, out["k_max"],
-                                              f"example {self.data.example_id}", action=action)
+        where = f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate"
+        out["k_over_k_max"] = check_time_step(self.k, out["k_max"], where, action=action)
         out["time_s"] = time.perf_counter() - start
         return out
 

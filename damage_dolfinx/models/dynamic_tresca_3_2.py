@@ -122,7 +122,8 @@ class DynamicTresca(TimeStepper):
         p = self.params  # Tresca adds no explicit stiffness: c_nu = 0; eta_* Phi_L only lowers B
         k_max = estimate_k_max(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
                                bcs=self.bcs)
-        check_time_step(self.k, k_max, f"example {self.data.example_id}", action=action)
+        where = f"{self.data.example_id}: explicit elastic force, eigenvalue estimate"
+        check_time_step(self.k, k_max, where, action=action)
         return float(k_max)
 
     # -- measured tangential displacement on named contact faces (Example 2: top vs bottom)

@@ -252,7 +252,8 @@ class FullyDamageableContact(TimeStepper):
                                  c_nu=self.c_nu if has_contact else 0.0, dsC=dsC, bcs=self.bcs,
                                  normal=self.n_facet)
         out["k_over_k_max"] = check_time_step(
-            self.k, out["k_max"], f"example {self.data.example_id}",
+            self.k, out["k_max"],
+            f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate",
             action=action if self.elastic_term == "explicit" else "off")
         out["time_s"] = time.perf_counter() - start
         return out

@@ -75,7 +75,7 @@ def check_time_step(k: float, k_max: float, where: str, action: str = "warn") ->
     if ratio <= 1.0 or action == "off":
         return ratio
     message = (f"time step k = {k:.4g} exceeds the stability limit k_max = {k_max:.4g} of the "
-               f"explicit elastic/contact force ({where}, k/k_max = {ratio:.3g}); use "
+               f"scheme's explicit terms ({where}, k/k_max = {ratio:.3g}); use "
                f"k <= {SAFETY * k_max:.4g} (0.8 k_max)")
     if action == "error":
         raise InputError(message + ", or --allow-unstable (Problem(allow_unstable=True)) to run "
