@@ -166,13 +166,14 @@ def test_collapse_detection_matches_saved_fields(tmp_path):
 
 def test_literal_linear_step_leaves_the_admissible_set(tmp_path):
     """--reading literal (= --set damage_bound=none) keeps the linear step (2.20): with the thesis
-    data the source violates (2.11) and zeta_n falls far below zeta_star (-554 on this mesh),
-    which is why the default (evidence) solves the step as the obstacle problem over
-    [zeta_star, 1]."""
-    run_cli(COARSE + ["--reading", "literal", "--out", tmp_path])
+    data the source violates (2.11) and zeta_n falls far below zeta_star (beyond -100 on this
+    mesh), which is why the default (evidence) solves the step as the obstacle problem over
+    [zeta_star, 1]. Such a state cannot be right: the run stops as failed (exit 3), saying so."""
+    proc = run_cli(COARSE + ["--reading", "literal", "--out", tmp_path], check=False)
+    assert proc.returncode == 3, proc.stderr
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert summary["damage_bound"] == "none" and summary["status"] == "collapse"
-    assert summary["zeta_min_run"] < -1.0
+    assert summary["damage_bound"] == "none" and summary["status"] == "failed"
+    assert "zeta left [zeta_star, 1]" in summary["error"]
 
 
 def test_damage_bound_is_checked(tmp_path):
