@@ -52,6 +52,9 @@ root_doc = "index"
 exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store",
                     "demos/*.md5", "demos/*.py", "demos/*.ipynb"]
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+# Sphinx >= 7.3 (Debian 13 and later) warns that sphinx_gallery_conf (it holds a sort key class)
+# cannot be cached between builds: the build is always complete anyway
+suppress_warnings = ["config.cache"]
 myst_heading_anchors = 3
 
 autodoc_member_order = "bysource"
