@@ -234,6 +234,16 @@ def _data_docstring(app, what, name, obj, options, lines):
         lines[:] = _attribute_comment(name.rsplit(".", 1)[-1], obj)
 
 
+def _offline_execution_times(app, docname, source):
+    """sphinx-gallery >= 0.14 (Debian 13 and later) styles its execution-time tables with
+    scripts and sheets from CDNs; the site loads nothing from the network, so those lines go (the
+    table stays, unstyled)."""
+    if docname.endswith("sg_execution_times"):
+        source[0] = "\n".join(line for line in source[0].splitlines()
+                              if not re.search(r"<(script|link)[^>]+https?://", line))
+
+
 def setup(app):
     app.connect("builder-inited", _generate)
+    app.connect("source-read", _offline_execution_times)
     app.connect("autodoc-process-docstring", _data_docstring)
