@@ -160,7 +160,8 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
     strong = npz(0.2 + 0.8 * cells[..., 1], "strong")
     assert judge(fig, [strong])[0] == "reproduced"
     wrong = npz(1.0 - 0.8 * cells[..., 1], "wrong")           # most damaged at the top
-    assert judge(fig, [wrong])[0].startswith("differs: does not hold: stress and damage")
+    assert judge(fig, [wrong])[0].startswith(
+        "differs: what the thesis says does not hold in our data: stress and damage")
     fitted = "R1 (evidence reading; FITTED value): kappa = 0.003 instead of kappa = 1 (line 3973). x"
     verdict = judge(fig, [strong], context={"departures": [fitted]})[0]
     assert verdict == "reproduced under a reading: kappa = 0.003 instead of kappa = 1 (fitted)"

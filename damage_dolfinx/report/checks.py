@@ -262,7 +262,8 @@ def judge(fig, npzs, related=(), context=None) -> tuple:
         return f"not comparable: {stop}", got, []
     failed = [desc for _, desc, ok in measured if not ok]
     if failed:
-        return "differs: does not hold: " + "; ".join(failed), got, failed
+        return ("differs: what the thesis says does not hold in our data: "
+                + "; ".join(failed) + " (measured: see what we get)"), got, failed
     held = "; ".join(desc for _, desc, _ in measured)
     if "pair_max_dzeta" in m and "damage_pattern_differs" in fig.checks \
             and m["pair_max_dzeta"] < 0.1 * (1 - zs):
