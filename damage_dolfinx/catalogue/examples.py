@@ -84,6 +84,7 @@ class Example:
     boundaries: Optional[dict] = None             # role -> tags (None: tags 1, 2, 3 as they are)
     own: bool = False                             # an own problem (Problem), not the catalogue
     allow_unstable: bool = False                  # a k above k_max: a warning, not a refusal
+    _requirements: Optional[tuple] = field(default=None, repr=False, compare=False)
 
     def with_reading(self, name=None) -> "Example":
         """This example under reading ``name`` (None: the default); raises InputError."""
@@ -169,11 +170,15 @@ class Example:
 
     def mesh_requirements(self):
         """(dimension, facet tags) a --mesh file must have: those of the built-in geometry
-        (built serially at the default size; runfolder.check_mesh_file)."""
-        import numpy as np
-        from mpi4py import MPI
-        geometry = self.make_geometry(MPI.COMM_SELF, self.n, self.h)
-        return self.dim, tuple(int(t) for t in np.unique(geometry.facet_tags.values))
+        (built serially at the default size, once per example; runfolder.check_mesh_file and
+        required_tags both ask)."""
+        if self._requirements is None:
+            import numpy as np
+            from mpi4py import MPI
+            geometry = self.make_geometry(MPI.COMM_SELF, self.n, self.h)
+            self._requirements = (self.dim, tuple(int(t) for t in
+                                                  np.unique(geometry.facet_tags.values)))
+        return self._requirements
 
     def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None):
         """Mesh, data and time stepper of one run (after validation)."""
@@ -216,15 +221,12 @@ class Example:
 
     def required_tags(self, comm) -> dict:
         """role -> tag of every boundary part the example's own mesh has (a mesh file given for
-        the example must have them too)."""
-        from mpi4py import MPI
-        from damage_dolfinx.meshes import tag_counts
+        the example must have them too; the tags of mesh_requirements, found on rank 0)."""
         from damage_dolfinx.models.registry import CLAMPED, TRACTION, CONTACT
-        own = self.make_geometry(MPI.COMM_SELF, self.n, self.h) if comm.rank == 0 else None
-        present = comm.bcast(tag_counts(own) if own is not None else None, root=0)
+        tags = comm.bcast(self.mesh_requirements()[1] if comm.rank == 0 else None, root=0)
         names = {CLAMPED: "clamped (Gamma_D)", TRACTION: "traction (Gamma_N)",
                  CONTACT: "contact (Gamma_C)"}
-        return {names[t]: t for t in (CLAMPED, TRACTION, CONTACT) if present.get(t)}
+        return {names[t]: t for t in (CLAMPED, TRACTION, CONTACT) if t in tags}
 
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]
