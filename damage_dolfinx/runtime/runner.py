@@ -30,7 +30,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx.runtime import checkpoint, io
-from damage_dolfinx.catalogue import examples
+from damage_dolfinx.catalogue import departures, examples
 from damage_dolfinx.numerics.damage import fast_path_counts
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
@@ -175,6 +175,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                "history_every": history_every,
                "steps_done": 0, "t_final": 0.0, "mpi_size": comm.size,
                "mesh": stepper.mesh_info(), "assumptions": ex.assumptions,
+               "reading": departures.record(ex),
                "outputs": {"xdmf": "fields.xdmf", "history": "history.csv",
                            "final_fields": "fields_final.npz", "figures": []},
                "environment": io.environment(comm)}
