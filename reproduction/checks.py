@@ -143,8 +143,9 @@ CHECKS = {  # name: (what is tested, predicate(measures, context) -> bool or Non
                                lambda m, c: m["u_top"] < 0.1 * max(m["u_bottom"], 1e-30)),
     "bottom_fixed": ("contact boundary (bottom) moves < 5 % of the largest displacement",
                      lambda m, c: m["u_bottom"] < 0.05),
-    "no_penetration": ("penetration into the obstacle (rms over the contact boundary, final "
-                       "time) below 1 % of the largest displacement",
+    "no_penetration": ("penetration into the obstacle below 1 % of the largest displacement "
+                       "(rms over the contact boundary at the final time, or the largest over "
+                       "the run where the run records that)",
                        lambda m, c: c["penetration_last"] <= 0.01 * m["u_max"]),
     "stressed": ("stress not zero at the final time", lambda m, c: m["stress_max"] > 0),
     "displaced": ("the body not back in its initial position at the final time (||u||_L2 above "
@@ -198,6 +199,8 @@ def run_context(folder) -> dict:
             c.update(u_L2_first=u[0], u_L2_last=u[-1], u_L2_max=max(u))
         if col("penetration_rms"):
             c["penetration_last"] = col("penetration_rms")[-1]
+        elif summary.get("max_penetration") is not None:  # largest over the run (the wrench)
+            c["penetration_last"] = float(summary["max_penetration"])
         if col("zeta_probe"):
             c["probe_min"] = min(col("zeta_probe"))
         if rows:

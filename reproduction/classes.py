@@ -115,8 +115,9 @@ def _classify(e: Evidence) -> str:
     tail = f"; departures: {departures_text(e.departures)}" if e.departures else ""
     failed = [c for c in measured if not c[1]]
     if failed:
-        return "differs: " + "; ".join(f"{c[0]} does not hold ({c[2]})" if c[2] else
-                                       f"{c[0]} does not hold" for c in failed) + tail
+        return "differs: " + "; ".join(f"the thesis says: {c[0]}; ours: {c[2]}" if c[2] else
+                                       f"the thesis says: {c[0]}; ours: it does not hold"
+                                       for c in failed) + tail
     held = "; ".join(f"{c[0]} ({c[2]})" if c[2] else c[0] for c in measured)
     if e.invisible:
         return f"not visible in this figure: {e.invisible}; the data show: {held}{tail}"

@@ -20,6 +20,7 @@ def table_rows(fidelity, results, study_folder, load_json, sort_key):
         got = (f"median ratio ours/thesis {t['ratio_median']:.3g} (min {t['ratio_min']:.3g}, max "
                f"{t['ratio_max']:.3g}) over {t['n_common']} of the thesis's {t['n_thesis']} cells; "
                f"rate {t['rate_ours']:.2f} vs {t['rate_thesis_common_cells']:.2f}"
+               + "".join(f" (left out: {x})" for x in t.get("excluded", []))
                if "ratio_median" in t else "no study")
         rows.append(dict(key=sort_key(t["table"], 0), item=f"Table {t['table']}",
                          anchor=f"table-{t['table'].replace('.', '-')}", example=t.get("study", ""),
