@@ -304,11 +304,43 @@ def draw_arrows(ax, tails, deltas, colour, label, size):
     ax.plot([], [], color=colour, lw=1.1, marker=">", markersize=4, label=label)  # legend entry
 
 
-def draw_setting(ax, cells, parts, loads=(), note=""):
+def _split_parts(parts, split):
+    """Boundary parts divided where a quantity changes along them (``split``: {label: (name,
+    function of the segment midpoints)}), e.g. the two friction planes of one contact part."""
+    out = []
+    for segs, colour, label, hatched in parts:
+        if not split or label not in split or segs.size == 0:
+            out.append((segs, colour, label, hatched))
+            continue
+        name, fn = split[label]
+        values = np.asarray(fn(segs.mean(1)), float)
+        for i, v in enumerate(np.unique(values)):
+            out.append((segs[values == v], colour, f"{label}, {name} = {v:g}", hatched,
+                        ("solid", "dashed", "dotted")[i % 3]))
+    return out
+
+
+def _free_edges(cells, parts):
+    """Outline edges of the mesh that no boundary part covers: traction-free."""
+    edges = boundary_edges(np.asarray(cells))
+    if not len(edges):
+        return edges
+    covered = [p[0].reshape(-1, 2, 2) for p in parts if p[0].size]
+    if not covered:
+        return edges
+    key = lambda segs: {tuple(sorted((tuple(np.round(a, 7)), tuple(np.round(b, 7)))))  # noqa: E731
+                        for a, b in segs}
+    taken = set().union(*(key(c) for c in covered))
+    return np.array([e for e in edges if tuple(sorted((tuple(np.round(e[0], 7)),
+                                                       tuple(np.round(e[1], 7))))) not in taken])
+
+
+def draw_setting(ax, cells, parts, loads=(), note="", split=None):
     """A thesis setting figure: the undeformed mesh, boundary parts (``parts``: (segments,
     colour, label, hatched)), load arrows (``loads``: ("f_N", segments, vectors, label) or
     ("f_B", points, vectors, label)); frames the axes on body, markers and arrows; ``note``
-    (e.g. why a load is not drawn) goes under the legend."""
+    (e.g. why a load is not drawn) goes under the legend. Outline edges no part covers are
+    drawn as traction-free; ``split`` divides a part where a quantity changes along it."""
     from matplotlib.collections import LineCollection, PolyCollection
     cells = np.asarray(cells)
     ax.add_collection(PolyCollection(cells, facecolors="none", edgecolors="0.6",
@@ -316,10 +348,15 @@ def draw_setting(ax, cells, parts, loads=(), note=""):
     size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
     inside = inside_test(cells)
     extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
-    for segs, colour, label, hatched in parts:
+    free = _free_edges(cells, parts)
+    if len(free):
+        ax.add_collection(LineCollection(free, colors="k", linewidths=1.0, linestyles="dashed",
+                                         label="traction-free boundary", zorder=3))
+    for segs, colour, label, hatched, *style in _split_parts(parts, split):
         if segs.size == 0:
             continue
         ax.add_collection(LineCollection(segs, colors=colour, linewidths=2.2,
+                                         linestyles=style[0] if style else "solid",
                                          label=mathtext(label), zorder=3))
         if hatched:
             ax.add_collection(LineCollection(support_hatch(segs, inside, size), colors=colour,
