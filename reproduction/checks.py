@@ -337,14 +337,13 @@ def describe(m: dict, c: dict, checks=()) -> str:
                      f"{m['pair_max_dzeta']:.2g}")
     if "u_max" in m and {"top_fixed_bottom_moves", "bottom_fixed", "deformation_grows",
                          "no_penetration"} & set(checks):
-        parts.append(f"max |u| = {m['u_max']:.3g} m on a body of size {m['size']:.3g} m, drawn "
-                     f"x{m['amplification']:g} (top edge {m['u_top']:.2f}, bottom edge "
-                     f"{m['u_bottom']:.2f} of max |u|)")
+        parts.append(f"max |u| = {m['u_max']:.3g} m on a body of size {m['size']:.3g} m (top "
+                     f"edge {m['u_top']:.2f}, bottom edge {m['u_bottom']:.2f} of max |u|)")
     if {"position_recovers", "displaced"} & set(checks) and "u_L2_first" in c:
         parts.append(f"||u||_L2 {c['u_L2_first']:.3g} m at t = 0, largest {c['u_L2_max']:.3g} m, "
                      f"{c['u_L2_last']:.3g} m at the final time")
     if "no_penetration" in checks and "penetration_last" in c:
-        parts.append(f"penetration (rms) {c['penetration_last']:.2g} m at the final time")
+        parts.append(f"penetration {c['penetration_last']:.2g} m (rms at the final time, or the largest over the run)")
     for key, label in (("hinges", "mechanism hinges"), ("failure_load_kN", "failure load [kN]"),
                        ("probe_min", "min ζ(0, 6)"), ("u_first", "max |u| first"),
                        ("u_last", "max |u| later"), ("strain_undamaged", "max strain undamaged"),

@@ -53,7 +53,8 @@ RULES = {
 }
 
 #: a damage field spanning less than this fraction of the fixed scale [zeta*, 1] is one colour
-ONE_COLOUR = 0.05
+#: (the figures add a panel on the field's own range below the same fraction)
+from damage_dolfinx.viz.figscales import NARROW_DAMAGE as ONE_COLOUR  # noqa: E402
 
 #: the suffix of a verdict judged on a quick (coarse) run
 QUICK = " (quick)"

@@ -53,7 +53,7 @@ def _f(number, example, shows, files, checks=(), kind="field", quote="", related
 
 THESIS_FIGURES = [
     _f("2.1", "2.1-ex1", "square (0,5)^2 with a clamped hole, mesh for n = 10",
-       ["figure_2_1.png"], kind="setting"),
+       ["figure_2_1.png"], kind="setting", thesis_run="n = 10"),
     _f("2.2", "2.1-ex1", "error against h + k: linear convergence (Table 2.1, not set beside ours)",
        ["figure_2_2.png"], kind="convergence"),
     _f("2.3", "2.1-ex2a", "disc |x| < 4 minus a diamond, mesh",
@@ -100,7 +100,7 @@ THESIS_FIGURES = [
        quote="As we expected, the damage is concentrated on the most stressed areas, the contact "
        "boundaries."),
     _f("2.14", "2.3-ex1", "unit square, mesh for n = 8", ["figure_2_14.png"],
-       kind="setting"),
+       kind="setting", thesis_run="n = 8"),
     _f("2.15", "2.3-ex1", "error against h + k (Table 2.5), linear convergence",
        ["figure_2_15.png"], kind="convergence"),
     _f("2.16", "2.3-ex2", "block pushed against a foundation", ["figure_2_16.png"],
@@ -126,7 +126,7 @@ THESIS_FIGURES = [
        quote="although the forces have vanished, at final time the configuration is not the "
        "stress-free one"),
     _f("2.22", "2.4-ex1", "unit square, mesh for n = 8", ["figure_2_22_tresca.png"],
-       kind="setting"),
+       kind="setting", thesis_run="n = 8"),
     _f("2.23", "2.4-ex1", "errors against h + k, Tresca (left) and Coulomb (right)",
        ["figure_2_23_left.png", "figure_2_23_right.png"], kind="convergence"),
     _f("2.24", "2.4-ex1", "Tresca, t = 1, n = 64: 'due to the friction, the highest "
@@ -180,7 +180,7 @@ THESIS_FIGURES = [
        quote="Clearly, inclusion of the damage effect leads to an increase of the magnitude of the"
        " deformation field."),
     _f("3.9", "3.2-ex1", "unit square, bilateral contact, mesh for n = 8",
-       ["figure_3_9.png"], kind="setting"),
+       ["figure_3_9.png"], kind="setting", thesis_run="n = 8"),
     _f("3.10", "3.2-ex2", "block between two frictional planes",
        ["figure_3_10.png"], kind="setting"),
     _f("3.11", "3.2-ex2", "deformed mesh (x5): 'the lower part of the contact "

@@ -28,6 +28,7 @@ def thesis_beside_ours(entry: dict, path: Path, title: str) -> Path:
     ax.set_xlabel("h + k")
     ax.set_ylabel("error (max over time)")
     ax.grid(True, which="both", alpha=0.3)
+    figstyle.log_tick_labels(ax)  # a log axis over less than two decades gets its 2 and 5 ticks
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.02, 1.0), frameon=False)
     ax.text(0.02, 0.02, f"median ratio ours/thesis {entry['ratio_median']:.2g}; rate thesis "

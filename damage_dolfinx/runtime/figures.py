@@ -20,26 +20,6 @@ def auto_amplification(stepper, diameter) -> float:
     return 0.1 * diameter / umax if umax > 0 else 1.0
 
 
-#: the drawn (amplified) largest displacement stays below this fraction of the diameter, so the
-#: drawn body stays within about 1.5 times its size
-READABLE = 0.5
-
-
-def readable_amplification(stepper, diameter, wanted=None) -> tuple:
-    """(factor, note): the factor a figure asks for (the thesis's, or None for the automatic
-    10 % of the diameter) unless it would draw the largest displacement beyond READABLE of
-    the diameter; then the automatic factor, and ``note`` says which factor was replaced."""
-    auto = auto_amplification(stepper, diameter)
-    if not wanted:
-        return auto, ""
-    u = stepper.u.x.array.reshape(-1, 2)
-    umax = stepper.comm.allreduce(float(np.max(np.linalg.norm(u, axis=1))) if u.size else 0.0,
-                                  op=MPI.MAX)
-    if umax * wanted <= READABLE * diameter:
-        return wanted, ""
-    return auto, f"; the thesis's ×{wanted:g} would draw |u| at {umax * wanted / diameter:.2g}× the size"
-
-
 def _setting_split(ex, stepper):
     """Contact parts whose friction bound changes along them (3.2 Example 2: g = 1 on the top
     plane, 1000 on the bottom one): {label: (name, function of points)} for the setting figure."""
@@ -90,11 +70,8 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
               "zeta": (stepper.zeta, "damage zeta [-]")}
     fields.update(getattr(stepper, "figure_fields", {}))  # problem-specific (name: (Function, label))
     diameter = ex.diameter if ex.diameter == ex.diameter else post.diameter(stepper.mesh)
-    amp, note = readable_amplification(stepper, diameter, fig.amplification)
+    amp = fig.amplification or auto_amplification(stepper, diameter)
     post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / filename,
-                     amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g}{note})",
-                     outline=True, mesh_lines=fig.mesh_lines)
-    entry = {"file": filename, "t": stepper.t, "amplification": amp}
-    if note:
-        entry["thesis_amplification"] = fig.amplification
-    return entry
+                     amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True,
+                     mesh_lines=fig.mesh_lines)  # figstyle.readable keeps the drawing readable
+    return {"file": filename, "t": stepper.t, "amplification": amp}

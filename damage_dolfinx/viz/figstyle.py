@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks,  # noqa: F401
+from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks, range_decimals,  # noqa: F401
                         is_damage, narrow_damage, shared_limits, si_unit)
 from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
                       error_mathtext, is_round, mathtext, round_amplification)
@@ -122,6 +122,31 @@ def _frame(ax, xy_list):
     ax.set_ylabel(r"$x_2$ [m]")
 
 
+#: the drawn (amplified) largest displacement stays below this fraction of the body's diameter,
+#: so that the drawn body stays within about 1.5 times its size
+READABLE = 0.5
+
+
+def readable(panels, ref_xy, amplification):
+    """(panels, factor, note): the panels redrawn with a factor that keeps the drawn largest
+    displacement below READABLE of the body's diameter (the automatic 10 %, rounded) when the
+    factor asked for (a thesis's) would not; ``note`` says which factor was replaced."""
+    if ref_xy is None or not amplification:
+        return panels, amplification, ""
+    ref = np.asarray(ref_xy, float)
+    size = float(np.hypot(*np.ptp(ref.reshape(-1, 2), axis=0)))
+    drawn = max(float(np.max(np.linalg.norm(np.asarray(p["xy"], float) - ref, axis=-1)))
+                for p in panels)
+    if size == 0 or drawn <= READABLE * size:
+        return panels, amplification, ""
+    umax = drawn / amplification
+    factor = round_amplification(0.1 * size / umax)
+    scaled = [dict(p, xy=ref + (np.asarray(p["xy"], float) - ref) * (factor / amplification))
+              for p in panels]
+    return scaled, factor, (f"\n(the ×{amplification:g} asked for would draw |u| at "
+                            f"{drawn / size:.2g}× the body's size)")
+
+
 def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_star=None,
                   mesh_only=False, limits=None):
     """Draw the panels of one figure. ``panels``: list of dicts with ``xy`` (nc, 3, 2) deformed
@@ -131,6 +156,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     every panel has a title (distinct bodies, e.g. undamaged and damaged runs side by side).
     Returns the colour limits used per panel (None for a mesh-only panel)."""
     pyplot = plt()
+    panels, amplification, replaced = readable(panels, ref_xy, amplification)
     nplot = len(panels) if not mesh_only or all("title" in p for p in panels) else 1
     allxy = [p["xy"] for p in panels] + ([ref_xy] if ref_xy is not None else [])
     extra = 0 if mesh_only or zeta_star is None else sum(
@@ -191,7 +217,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
         ax.set_ylim(src.get_ylim())
         ax.set_aspect("equal")
         ax.set_xlabel(src.get_xlabel())
-    full = mathtext(title) + f" — {amplification_text(amplification)}"
+    full = mathtext(title) + f" — {amplification_text(amplification)}{replaced}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
     fig.savefig(path, dpi=DPI, bbox_inches="tight")
@@ -207,12 +233,16 @@ def _stretched_damage(fig, ax, tri, vals, lo, hi):
     else:
         im = ax.tripcolor(tri, facecolors=vals, cmap=STRETCHED_CMAP, vmin=lo, vmax=hi)
     cb = colorbar(fig, ax, im, "$\\zeta$ (scale: range of the field)")
-    plain_ticks(cb.ax.yaxis)
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
+    digits = range_decimals(lo, hi)
+    cb.ax.yaxis.set_major_locator(MaxNLocator(4))
+    cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.{digits}f}"))
     ax.set_title(f"the same damage, colours stretched\nto its range [{lo:.3g}, {hi:.3g}]")
 
 
-#: colour map of the stretched damage panel (distinct from the fixed one: not to be compared)
-STRETCHED_CMAP = "cividis"
+#: colour map of the stretched damage panel: the damage's own (one colour map per field); its
+#: colour bar and title say that the scale is the field's range
+STRETCHED_CMAP = DAMAGE_CMAP
 
 
 def suptitle_on_top(fig, text):
@@ -258,12 +288,18 @@ def render_saved(npz, png, limits=None) -> list:
 
 def render_pair(npz_a, npz_b, png_a, png_b):
     """Re-render two figures of a thesis pair with one stress scale per non-damage panel."""
-    (pa, ma, _), (pb, mb, _) = load_panels(npz_a), load_panels(npz_b)
+    return render_shared([npz_a, npz_b], [png_a, png_b])
+
+
+def render_shared(npzs, pngs):
+    """Re-render figures of one run or one thesis pair with one scale per non-damage panel
+    (a stress that has nearly vanished then reads as such, not as a stress field of its own)."""
+    loaded = [load_panels(n)[0] for n in npzs]
     limits = {}
-    for i, (a, b) in enumerate(zip(pa, pb)):
-        if not is_damage(a["name"], a["label"]):
-            limits[i] = shared_limits([a["values"], b["values"]])
-    return render_saved(npz_a, png_a, limits), render_saved(npz_b, png_b, limits)
+    for i in range(min(len(p) for p in loaded)):
+        if not any(is_damage(p[i]["name"], p[i]["label"]) for p in loaded):
+            limits[i] = shared_limits([p[i]["values"] for p in loaded])
+    return [render_saved(n, png, limits) for n, png in zip(npzs, pngs)]
 
 
 # ---------------------------------------------------------------------------- setting figures
