@@ -232,3 +232,29 @@ def figure_number(filename: str):
     """'figure_2_12_left.png' -> (2, 12, 'left'); None for other PNGs."""
     m = re.match(r"figure_(\d+)_(\d+)(?:_(.*))?\.png$", Path(filename).name)
     return (int(m.group(1)), int(m.group(2)), m.group(3) or "") if m else None
+
+
+#: what a thesis figure draws beside the body (figstyle.draw_guides), by our PNG name: the
+#: foundation under the beam of 3.4/3.5 and the slope plane and obstacle of 3.13 (drawn in
+#: the slope-aligned frame of the run, x1 up the slope)
+GUIDES = {
+    "figure_3_4.png": [{"line": [[0.0, 0.0], [3.0, 0.0]], "label": "the deformable foundation"}],
+    "figure_3_5.png": [{"line": [[0.0, 0.0], [3.0, 0.0]], "label": "the deformable foundation"}],
+    "figure_3_13.png": [{"line": [[0.0, 0.0], [2.0, 0.0]],
+                         "label": "the slope plane (bottom; x1 up the slope, Tresca g = 1)"},
+                        {"line": [[0.0, 0.0], [0.0, 1.0]], "label": "the obstacle (left, g = 1)"}],
+}
+
+#: figures that mark the hinges of the arch's collapse mechanism (from its run's summary.json)
+HINGE_FIGURES = ("figure_2_8.png", "figure_2_9.png")
+
+
+def guides(png: str, summary=None) -> list:
+    """The guides of one of our PNGs: GUIDES, and the mechanism hinges of the arch (its run's
+    summary: position on the centre line, the face that opens)."""
+    out = list(GUIDES.get(png, []))
+    if png in HINGE_FIGURES and summary:
+        out += [{"point": [h["x_m"], h["y_m"]], "mark": h["opening_face"][0].upper(),
+                 "note": "red circles: mechanism hinges (E / I: the extrados / intrados opens)"}
+                for h in summary.get("hinges", []) if h.get("mechanism")]
+    return out

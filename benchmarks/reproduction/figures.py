@@ -40,6 +40,23 @@ def restyle(out: Path, index: dict) -> int:
     return done
 
 
+def draw_guides(out: Path, index: dict) -> int:
+    """Re-render the figures that draw something beside the body (the foundation, slope and
+    obstacle planes, the arch's hinges: reproduction.figures.guides) from their panel data."""
+    import json
+    from reproduction.figures import guides
+    done = 0
+    for entry in index["figures"]:
+        npz = _npz(out, index, entry)
+        summary_path = npz.parent / "summary.json" if npz else None
+        summary = json.loads(summary_path.read_text()) if summary_path and summary_path.is_file() else None
+        marks = guides(entry["file"], summary)
+        if npz and marks:
+            figstyle.render_saved(npz, out / entry["file"], guides=marks)
+            done += 1
+    return done
+
+
 def share_pair_scales(out: Path, index: dict) -> list:
     """Re-render every group of PAIRS present in ``out`` on shared scales; returns the groups."""
     done = []
@@ -77,10 +94,11 @@ if a.restyle:
     import json
     index = json.loads((out / "index.json").read_text())
     print(f"restyled {restyle(out, index)} figures in {out}; shared scales: "
-          f"{len(share_pair_scales(out, index))}")
+          f"{len(share_pair_scales(out, index))}; with guides: {draw_guides(out, index)}")
     raise SystemExit(0)
 index = reproduce.run_figures(mode, out, a.np, a.only, a.resume)
 shared = share_pair_scales(out, index)
+draw_guides(out, index)
 failed = [r for r in index["runs"] if r["returncode"] != 0]
 print(f"{len(index['figures'])} figures from {len(index['runs'])} runs in "
       f"{index['wall_time_this_invocation_s']} s (runs: {index['wall_time_s']} s in two lanes) "

@@ -147,8 +147,40 @@ def readable(panels, ref_xy, amplification):
                             f"{drawn / size:.2g}× the body's size)")
 
 
+def draw_guides(ax, guides, xy=None, ref_xy=None):
+    """What the thesis's figure draws beside the body: obstacle and friction planes (``line``:
+    two end points, drawn as a thick grey line with its label) and marked points (``point``:
+    an undeformed position, drawn where that material point is in the drawn configuration:
+    the hinges of the arch)."""
+    for g in guides or ():
+        if "line" in g:
+            (x0, y0), (x1, y1) = g["line"]
+            ax.plot([x0, x1], [y0, y1], color="0.35", lw=3.0, solid_capstyle="butt", zorder=4)
+        elif "point" in g:
+            p = np.asarray(g["point"], float)
+            if xy is not None and ref_xy is not None:
+                ref = np.asarray(ref_xy, float).reshape(-1, 2)
+                p = np.asarray(xy, float).reshape(-1, 2)[np.argmin(np.linalg.norm(ref - p, axis=1))]
+            ax.plot(*p, marker="o", ms=7, mfc="none", mec="red", mew=1.6, zorder=5)
+            centre = np.mean(ax.get_xlim()), np.mean(ax.get_ylim())
+            if xy is not None:
+                pts = np.asarray(xy, float).reshape(-1, 2)
+                centre = (pts.min(0) + pts.max(0)) / 2
+            inward = np.asarray(centre) - p
+            inward = 11 * inward / max(np.linalg.norm(inward), 1e-300)
+            ax.annotate(g.get("mark", ""), xy=p, fontsize=7, color="red", xytext=inward,
+                        textcoords="offset points", ha="center", va="center", zorder=5)
+    lines = [g["label"] for g in guides or () if "line" in g and g.get("label")]
+    notes = [g["note"] for g in guides or () if g.get("note")] + \
+        ([f"grey line{'s' if len(lines) > 1 else ''}: " + "; ".join(lines)] if lines else [])
+    if notes:  # under the x label, never over the body
+        ax.annotate("; ".join(dict.fromkeys(notes)), xy=(0.5, 0.0), xycoords="axes fraction",
+                    xytext=(0, -36), textcoords="offset points", ha="center", va="top",
+                    fontsize=7, color="0.2")
+
+
 def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_star=None,
-                  mesh_only=False, limits=None):
+                  mesh_only=False, limits=None, guides=None):
     """Draw the panels of one figure. ``panels``: list of dicts with ``xy`` (nc, 3, 2) deformed
     triangles, ``values`` (nc, 3) P1 or (nc,) DG0, ``name`` and ``label``. ``limits``: optional
     {panel index: (vmin, vmax)} (shared pair scales). A panel's optional ``title`` replaces the
@@ -208,7 +240,9 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
             used.append((vmin, vmax))
         if ref_xy is not None:
             draw_outline(ax, np.asarray(ref_xy))
-        _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else []))
+        draw_guides(ax, guides, xy, ref_xy)
+        _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else [])
+               + [np.asarray(g["line"], float) for g in guides or () if "line" in g])
     for ax, (src, tri, vals, lo, hi) in zip(axes[nplot:], stretched):
         _stretched_damage(fig, ax, tri, vals, lo, hi)
         if ref_xy is not None:
@@ -278,12 +312,12 @@ def load_panels(npz):
     return panels, meta, (d["ref_xy"] if "ref_xy" in d else None)
 
 
-def render_saved(npz, png, limits=None) -> list:
+def render_saved(npz, png, limits=None, guides=None) -> list:
     panels, meta, ref = load_panels(npz)
     return render_fields(panels, png, title=meta.get("title", ""),
                          amplification=meta.get("amplification", 1.0), ref_xy=ref,
                          zeta_star=meta.get("zeta_star"), mesh_only=meta.get("mesh_only", False),
-                         limits=limits)
+                         limits=limits, guides=guides)
 
 
 def render_pair(npz_a, npz_b, png_a, png_b):
