@@ -85,16 +85,21 @@ p.add_argument("--out", default=None)
 p.add_argument("--only", nargs="+", help="example ids")
 p.add_argument("--restyle", action="store_true",
                help="no runs: re-render the figures of OUT from their panel data (current style)")
+p.add_argument("--settings", action="store_true",
+               help="no runs: redraw the setting figures of OUT from one time step of each job")
 p.add_argument("--resume", action="store_true",
                help="keep the runs that completed in an earlier invocation into the same OUT")
 a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/figures-quick" if a.quick else "results/figures"))
+if a.settings:
+    print(f"redrawn: {' '.join(reproduce.redraw_settings(mode, out))}")
 if a.restyle:
     import json
     index = json.loads((out / "index.json").read_text())
     print(f"restyled {restyle(out, index)} figures in {out}; shared scales: "
           f"{len(share_pair_scales(out, index))}; with guides: {draw_guides(out, index)}")
+if a.restyle or a.settings:
     raise SystemExit(0)
 index = reproduce.run_figures(mode, out, a.np, a.only, a.resume)
 shared = share_pair_scales(out, index)

@@ -420,8 +420,8 @@ def draw_setting(ax, cells, parts, loads=(), note="", split=None):
     extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
     free = _free_edges(cells, parts)
     if len(free):
-        ax.add_collection(LineCollection(free, colors="k", linewidths=1.0, linestyles="dashed",
-                                         label="traction-free boundary", zorder=3))
+        ax.add_collection(LineCollection(free, colors="k", linewidths=1.4,  # solid: dashes
+                                         label="traction-free boundary", zorder=3))  # restart per facet
     for segs, colour, label, hatched, *style in _split_parts(parts, split):
         if segs.size == 0:
             continue
