@@ -165,10 +165,11 @@ def record_departures(summary: dict, catalogue=None) -> list:
     """The departure records of a run or study: its summary's ``reading`` record; for a
     summary written before runs recorded it, the catalogue's record of its example under the
     reading its assumptions name."""
-    reading = summary.get("reading")
-    if isinstance(reading, dict):
-        return list(reading.get("departures", []))
     from damage_dolfinx.catalogue import departures, examples
+    reading = summary.get("reading")
+    if isinstance(reading, dict):  # the short form from the recorded entry, as parsed today
+        return [departures.parse(d["text"]) or d if d.get("text") else d
+                for d in reading.get("departures", [])]
     name = reading if isinstance(reading, str) else None
     for a in summary.get("assumptions", []):
         if name is None and a.startswith("reading: "):
