@@ -108,8 +108,9 @@ def test_setting_figure_draws_loads_and_supports(tmp_path, monkeypatch):
     seen = {}
     draw = figstyle.draw_setting
     monkeypatch.setattr(figstyle, "draw_setting",
-                        lambda ax, cells, parts, loads=(), note="": seen.update(
-                            parts=parts, loads=loads, note=note) or draw(ax, cells, parts, loads, note))
+                        lambda ax, cells, parts, loads=(), note="", split=None: seen.update(
+                            parts=parts, loads=loads, note=note) or draw(ax, cells, parts, loads,
+                                                                         note, split))
     ex = examples.get("2.3-ex3")
     stepper = ex.build(MPI.COMM_SELF, n=4)
     fig = next(f for f in ex.figures if f.kind == "mesh")
