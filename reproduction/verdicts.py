@@ -14,6 +14,11 @@ CSS = {"reproduced": "v-reproduced", "reproduced under a reading": "v-reading",
        "not comparable": "v-not"}
 
 
+def md_cell(text: str) -> str:
+    """Text in a Markdown table cell (its norms' bars escaped: ||u|| would split the cell)."""
+    return text.replace("|", "\\|")
+
+
 def table_rows(fidelity, results, study_folder, load_json, sort_key):
     rows = []
     for t in fidelity["tables"]:
@@ -53,8 +58,8 @@ def summary_table(doc, rows, fidelity):
         f'<td class="l {CSS[category(r["verdict"])]}">{_inline(r["verdict"])}</td></tr>'
         for r in rows)
     md = "| item | example | thesis | ours | verdict |\n|---|---|---|---|---|\n" + "".join(
-        f"| [{r['item']}](#{r['anchor']}) | {r['example']} | {r['shows']} | {r['got']} | "
-        f"{r['verdict']} |\n" for r in rows)
+        f"| [{r['item']}](#{r['anchor']}) | {r['example']} | {md_cell(r['shows'])} | "
+        f"{md_cell(r['got'])} | {md_cell(r['verdict'])} |\n" for r in rows)
     doc.raw('<table class="summary"><tr><th class="l">item</th><th class="l">example</th>'
             '<th class="l">what the thesis shows</th><th class="l">what we get</th>'
             f'<th class="l">verdict</th></tr>{body}</table>', md)

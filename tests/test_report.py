@@ -48,11 +48,12 @@ def test_quick_figures_and_report(tmp_path):
                        r"drawing of an assumed one; (\d+) not visible in the figure, (\d+) differ, "
                        r"(\d+) not comparable; (\d+) verdicts are judged on quick", md)
     assert counts and sum(map(int, counts.groups()[1:8])) == int(counts.group(1))
-    assert int(counts.group(9)) >= 1 and md.index("Preview") < md.index("Contents")
+    assert int(counts.group(9)) >= 1 and md.index("Preview") < md.index("- [Summary")
     # one source: every table verdict of fidelity.md is the summary row's verdict
+    from reproduction.verdicts import md_cell
     fidelity = json.loads((tmp_path / "fidelity" / "fidelity.json").read_text())
     for t in fidelity["tables"]:
-        assert f"| {t['verdict']} |" in md, t["table"]
+        assert f"| {md_cell(t['verdict'])} |" in md, t["table"]
         if t.get("departures"):
             assert t["verdict"].startswith(("reproduced under a reading", "differs")), t["table"]
     assert 'id="fig-2-14"' in text and "§2.3.3, p. 106" in text   # the figure, where in the thesis

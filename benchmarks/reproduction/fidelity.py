@@ -40,6 +40,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
 from common import REPO  # noqa: E402
 from reproduction.classes import QUICK, Evidence, classify, record_departures  # noqa: E402
+from reproduction.verdicts import md_cell  # noqa: E402
 
 LOCAL_TABLES = REPO / "benchmarks" / "thesis_tables.json"
 REFERENCE = REPO / "benchmarks" / "reference_output" / "convergence"
@@ -225,12 +226,12 @@ def summary_markdown(result: dict) -> str:
              "| rate thesis / ours | verdict |", "|---|---|---|---|---|---|"]
     for t in result["tables"]:
         if not t.get("cells") or "ratio_median" not in t:
-            lines.append(f"| {t['table']} | {t['study']} | - | - | - | {t['verdict']} |")
+            lines.append(f"| {t['table']} | {t['study']} | - | - | - | {md_cell(t['verdict'])} |")
             continue
         lines.append(f"| {t['table']} | {t['study']} ({t['source']}) | {t['n_common']} of "
                      f"{t['n_thesis']} | {_g(t['ratio_min'])} / {_g(t['ratio_median'])} / "
                      f"{_g(t['ratio_max'])} | {t['rate_thesis_common_cells']:.2f} / "
-                     f"{t['rate_ours']:.2f} | {t['verdict']} |")
+                     f"{t['rate_ours']:.2f} | {md_cell(t['verdict'])} |")
     return "\n".join(lines) + "\n"
 
 
