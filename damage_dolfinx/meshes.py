@@ -119,8 +119,7 @@ def retag(geometry: Geometry, boundaries, required=None, model_id=None) -> Geome
     2 traction, 3 contact), from ``boundaries`` = {role: tag or tags}; None keeps the tags as
     they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty."""
     from damage_dolfinx import compat
-    from damage_dolfinx.models.registry import (CLAMPED, CONTACT, CONTACT_ROLES, MODELS,
-                                                TRACTION)
+    from damage_dolfinx.models.registry import CLAMPED, CONTACT, CONTACT_ROLES, TRACTION, model
     counts = tag_counts(geometry)
     where = geometry.description or "the mesh"
     for what, tag in (required or {}).items():
@@ -128,12 +127,12 @@ def retag(geometry: Geometry, boundaries, required=None, model_id=None) -> Geome
             raise InputError(f"{where}: the {what} tag {tag} is missing or empty")
     if boundaries is None:
         return geometry
-    allowed = ("clamped", "traction") + (MODELS[model_id].contact if model_id else CONTACT_ROLES)
+    allowed = ("clamped", "traction") + (model(model_id).contact_roles if model_id else CONTACT_ROLES)
     internal = {"clamped": CLAMPED, "traction": TRACTION}
     mapping = {}
     for role, tags in boundaries.items():
         if role not in allowed:
-            raise InputError(f"boundary role {role!r} is not one of model {model_id}'s: "
+            raise InputError(f"boundary role {role!r} is not one of model {model(model_id).id}'s: "
                              f"{', '.join(allowed)}")
         for tag in ([tags] if isinstance(tags, (int, np.integer)) else list(tags)):
             if not counts.get(int(tag)):

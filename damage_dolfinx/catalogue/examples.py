@@ -63,7 +63,7 @@ class Example:
     T: float
     k: float
     make_geometry: Callable          # (comm, n, h) -> Geometry
-    model: str                       # the model id (models/registry.py: "2.1" ... "3.3")
+    model: object                    # the model: an id ("2.1" ... "3.3") or a Model class
     diameter: float
     n: Optional[int] = None          # structured meshes: cells per side
     h: Optional[float] = None        # gmsh meshes: element size
@@ -85,6 +85,11 @@ class Example:
     own: bool = False                             # an own problem (Problem), not the catalogue
     allow_unstable: bool = False                  # a k above k_max: a warning, not a refusal
     _requirements: Optional[tuple] = field(default=None, repr=False, compare=False)
+
+    @property
+    def model_id(self) -> str:
+        """The id of the example's model (its ``model`` may be the class itself)."""
+        return self.model if isinstance(self.model, str) else self.model.id
 
     def with_reading(self, name=None) -> "Example":
         """This example under reading ``name`` (None: the default); raises InputError."""
@@ -120,7 +125,7 @@ class Example:
             return ex.configure(n, k, T, h, overrides, mesh_file, comm)
         overrides = dict(overrides or {})
         allow_long = bool(overrides.pop("allow_long", False))
-        from damage_dolfinx.models.registry import model as model_info, quasistatic_k_max
+        from damage_dolfinx.models.registry import model as model_info
         info = model_info(self.model)
         # a time step you choose above k_max is refused (stability_check = error) unless the
         # check is set explicitly (--allow-unstable sets warn); the thesis's own steps (defaults,
@@ -133,16 +138,16 @@ class Example:
             if "stability_check" in self.params.extra and k is not None:
                 overrides["stability_check"] = action
         from damage_dolfinx.models.registry import validate
-        params = validate(info.id, self.params.replace(**overrides))
+        params = validate(info, self.params.replace(**overrides))
         T = self.T if T is None else float(T)
         if k is None and self.own:  # an own problem's k is its author's choice
             k = self.k
         k = self.default_k(n, h, T, params) if k is None else float(k)
         time = TimeGrid(k, T)
-        k_max = quasistatic_k_max(info.id, params)
+        k_max = info.k_max(params)
         if k > k_max:
             from damage_dolfinx.numerics.stability import check_time_step
-            check_time_step(k, k_max, f"{self.id}: {info.explicit}", action=action)
+            check_time_step(k, k_max, f"{self.id}: {info.stability_limit}", action=action)
         if n is not None and self.n is None:
             raise InputError(f"example {self.id} uses a gmsh mesh: set its size with --h, not --n")
         if h is not None and self.h is None:
@@ -197,21 +202,22 @@ class Example:
         data = ProblemData(self.id, geometry, params, time, self.body_force, self.traction,
                            self.zeta0, self.builders, self.damage_law, self.irreversible)
         from damage_dolfinx.models.registry import model as model_info
-        return model_info(self.model).stepper_class()(data)
+        return model_info(self.model)(data)
 
     def default_k(self, n, h, T, params) -> float:
         """The default time step at mesh (n, h) and final time T: the example's k, made smaller
         in proportion to the cell size on meshes finer than the default for the dynamic models
         (their k_max is proportional to h), kept below 0.8 k_max for the quasistatic ones with an
         explicit term, and made to divide T (k = T/N, N the smallest count with k below that)."""
-        from damage_dolfinx.models.registry import quasistatic_k_max
+        from damage_dolfinx.models.registry import model as model_info
+        info = model_info(self.model)
         k, scaled = self.k, False
-        if self.model.startswith("3."):
+        if info.dynamic:  # k_max proportional to h
             if n is not None and self.n and n > self.n:
                 k, scaled = k * self.n / n, True
             if h is not None and self.h and h < self.h:
                 k, scaled = k * h / self.h, True
-        k_max = quasistatic_k_max(self.model, params)
+        k_max = info.k_max(params)
         if k > 0.8 * k_max:
             k, scaled = 0.8 * k_max, True
         ratio = T / k

@@ -123,7 +123,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
     settings = {"example": ex.id, "n": n, "h": h, "k": grid.k, "overrides": overrides or {},
                 "mesh_file": str(mesh_file) if mesh_file else None}
     if ex.own:  # an own problem: a restart must continue the same model and data
-        settings.update(model=ex.model, parameters=params.as_dict())
+        settings.update(model=ex.model_id, parameters=params.as_dict())
     previous = previous_run(out, comm)
     resume = None
     if restart:
