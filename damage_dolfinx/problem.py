@@ -107,7 +107,7 @@ class Problem:
 
     def example(self):
         """The run description the run machinery takes (internal)."""
-        from damage_dolfinx.catalogue.examples import Example, Figure
+        from damage_dolfinx.description import Example, Figure
         from damage_dolfinx.laws import DamageLaw
         from damage_dolfinx.meshes import as_geometry
         from damage_dolfinx.models.registry import model

@@ -97,6 +97,8 @@ class Model:
     checkpoint_fields: tuple = ("u", "zeta")
     #: the scalars this model adds to history.csv
     history_columns: tuple = ()
+    #: the sub-steps in order: (attribute holding the solver, kind, PETSc options prefix)
+    scheme: tuple = ()
 
     # -- the declarations a run reads before building anything
     @classmethod
@@ -129,8 +131,9 @@ class Model:
         self._history_columns = list(columns)
 
     def sub_steps(self) -> list:
-        """The scheme's sub-steps in order (:class:`SubStep`); for reading and tuning."""
-        return []
+        """The scheme's sub-steps in order (:class:`SubStep`), from ``scheme``."""
+        return [SubStep(name, getattr(self, name), kind, prefix)
+                for name, kind, prefix in self.scheme if getattr(self, name, None) is not None]
 
     def __init__(self, data: ProblemData):
         self.data, self.params = data, data.params

@@ -40,7 +40,7 @@ from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData, SubStep
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -61,6 +61,7 @@ class DynamicKelvinVoigt(Model):
     stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("v_L2", "u_max", "penetration_rms")
+    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # damage, (3.48)
 
     @classmethod
     def defaults(cls) -> ModelParameters:

@@ -33,7 +33,7 @@ from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_form
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import check_time_step, estimate_k_max
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData, SubStep
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -53,6 +53,7 @@ class DynamicTresca(Model):
     stability_limit = "explicit elastic force (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face
+    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))
 
     @classmethod
     def defaults(cls) -> ModelParameters:

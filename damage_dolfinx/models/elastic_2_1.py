@@ -34,7 +34,7 @@ from damage_dolfinx.numerics.solvers import LinearSolver, lagged_direct
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
-from damage_dolfinx.models.base import Model, ProblemData, SubStep
+from damage_dolfinx.models.base import Model, ProblemData
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -46,6 +46,7 @@ class ElasticDamage(Model):
     contact_roles = ("bilateral",)
     #: u, zeta and the lagged preconditioner's damage (see checkpoint_state)
     checkpoint_fields = ("u", "zeta", "zeta_pc")
+    scheme = (("damage", "linear", "damage_"), ("mech", "linear", "mech_"))   # (2.20), (2.21)
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -135,10 +136,6 @@ class ElasticDamage(Model):
             self.zeta.x.array[:] = self.zeta_pc.x.array
             self.mech.factorise_now()
             self.zeta.x.array[:] = zeta_n
-
-    def sub_steps(self) -> list:
-        return [SubStep("damage", self.damage, "linear", "damage_"),                    # (2.20)
-                SubStep("mech", self.mech, "linear", "mech_")]                          # (2.21)
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)

@@ -51,7 +51,7 @@ from damage_dolfinx.parameters import InputError, ModelParameters
 from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
 from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
 from damage_dolfinx.numerics.zeta_linear import VelocitySolver
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData, SubStep
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 
 #: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
 #: VELOCITY_EXTRAPOLATION);
@@ -80,6 +80,7 @@ class FullyDamageableContact(Model):
     stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("v_L2",)  # + the contact monitor's and the probe's columns
+    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # (3.158), (3.159)
 
     @classmethod
     def defaults(cls) -> ModelParameters:

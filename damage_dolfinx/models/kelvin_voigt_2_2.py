@@ -31,7 +31,7 @@ from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData, SubStep
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -44,6 +44,7 @@ class KelvinVoigtTresca(Model):
     contact_roles = ("tresca",)
     stability_limit = "explicit elastic term: k <= 2/m_visc"
     checkpoint_fields = ("u", "zeta", "v")
+    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))  # (1), (2.67)
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -103,10 +104,6 @@ class KelvinVoigtTresca(Model):
         self.timings["friction"] += time.perf_counter() - middle
         self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array
         return {"damage_its": damage_its, "snes_its": friction_its}
-
-    def sub_steps(self) -> list:
-        return [SubStep("damage", self.damage, "snes-vi", "damage_"),                  # (1)
-                SubStep("friction", self.friction, self.friction.name, "friction_")]   # (2.67)
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)

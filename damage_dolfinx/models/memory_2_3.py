@@ -34,7 +34,7 @@ from damage_dolfinx.numerics.memory import MemoryKernel, MemoryTerm
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData, SubStep
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -59,6 +59,8 @@ class ViscoelasticMemoryContact(Model):
     title = "quasistatic viscoelastic body with long memory, normal compliance"
     contact_roles = ("normal_compliance",)
     history_columns = ("penetration_rms", "stress_L2")
+    scheme = (("memory", "update", ""), ("damage", "linear", "damage_"),
+              ("mech", "semismooth", "mech_"))
 
     @classmethod
     def defaults(cls) -> ModelParameters:

@@ -13,8 +13,7 @@ import importlib
 from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION  # noqa: F401
 from damage_dolfinx.parameters import InputError, ModelParameters
 
-#: contact roles: what Gamma_C means in each model
-CONTACT_ROLES = ("bilateral", "tresca", "coulomb", "normal_compliance")
+from damage_dolfinx.meshes import CONTACT_ROLES  # noqa: E402 (what Gamma_C may mean)
 ROLES = ("clamped", "traction") + CONTACT_ROLES
 
 #: the modules under damage_dolfinx/models/ holding the catalogue's models, in catalogue order

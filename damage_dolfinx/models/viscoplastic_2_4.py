@@ -30,7 +30,7 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.numerics.cellwise_stress import StressUpdate
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData, SubStep
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -47,6 +47,7 @@ class ElastoViscoplasticFriction(Model):
     stability_limit = "explicit viscoplastic term: k <= 2/(1 - zeta*)"
     checkpoint_fields = ("u", "zeta", "w", "sigma")
     history_columns = ("stress_Q", "slip_max", "zeta_min_x", "zeta_min_y")
+    scheme = (("friction", "newton", "friction_"), ("damage", "snes-vi", "damage_"))  # (2), (4)
 
     @classmethod
     def defaults(cls) -> ModelParameters:

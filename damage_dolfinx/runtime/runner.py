@@ -30,7 +30,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx.runtime import checkpoint, io
-from damage_dolfinx.catalogue import examples
+from damage_dolfinx.runtime.cases import resolve  # noqa: F401 (studies)
 from damage_dolfinx.numerics.damage import fast_path_counts
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
@@ -76,7 +76,7 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     [zeta_star, 1] (beyond STATE_TOLERANCE) in a field, and every exception of a solver, end
     the run as a ConvergenceError with status "failed" in summary.json."""
     ex = resolve(example_id, overrides)
-    configured = ex.configure(n, k, T, h, overrides, mesh_file)
+    configured = ex.configure(n, k, T, h, overrides, mesh_file, comm)
     every = history_every if history_every is not None else \
         configured[0].extra.get("history_every", 1)
     if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
@@ -104,15 +104,6 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                         overwrite, comm, signals, lock, every)
     finally:
         lock.release()
-
-
-def resolve(case, overrides=None):
-    """A catalogue id, a public Problem or an Example -> the Example to run."""
-    if isinstance(case, str):
-        return examples.get(case, (overrides or {}).get("reading"))
-    if hasattr(case, "example"):
-        return case.example()
-    return case
 
 
 def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figures, time_limit,
@@ -150,7 +141,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             print(f"damage-dolfinx: {', '.join(repaired)} restored to its last complete output "
                   "time (the run was killed while writing it)", file=sys.stderr, flush=True)
     try:  # before any step: a solver that cannot be set up is refused input (PETSc options)
-        stepper = solver_step(lambda: ex.build(comm, n, k, T, h, overrides, mesh_file),
+        stepper = solver_step(lambda: ex.build(comm, n, k, T, h, overrides, mesh_file,
+                                               configured),
                               "cannot set up the solvers")
     except ConvergenceError as exc:
         raise InputError(str(exc)) from None
