@@ -296,6 +296,30 @@ class Model:
         m.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         return (*mats, m, m.sum(), mats[0].createVecLeft())
 
+    # -- contact
+    def contact_pressure(self):
+        """The normal contact pressure on Gamma_C as a UFL expression of the live Functions
+        (None: the model has no normal-compliance contact)."""
+        return None
+
+    def contact_resultant(self):
+        """int_{Gamma_C} p nu ds, the force of the foundation's pressure on the body, as a
+        NumPy vector on every rank (None without normal contact); forms compiled once."""
+        if not hasattr(self, "_resultant_forms"):
+            p = self.contact_pressure()
+            if p is None:
+                self._resultant_forms = None
+            else:
+                from damage_dolfinx.geometries import GAMMA_C
+                n = ufl.FacetNormal(self.mesh)
+                ds = ufl.Measure("ds", domain=self.mesh,
+                                 subdomain_data=self.data.geometry.facet_tags)
+                self._resultant_forms = [compat.form(p * n[i] * ds(GAMMA_C))
+                                         for i in range(self.mesh.geometry.dim)]
+        if self._resultant_forms is None:
+            return None
+        return np.array([compat.assemble_scalar(f, self.comm) for f in self._resultant_forms])
+
     def iteration_totals(self) -> dict:
         return {}
 

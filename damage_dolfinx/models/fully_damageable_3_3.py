@@ -315,6 +315,12 @@ class FullyDamageableContact(Model):
         out.update(self.profiles.summary(self.zeta, self.t))
         return out
 
+    def contact_pressure(self):
+        """eta_*(zeta_n) c_nu (u_n.nu - gap)_+ on Gamma_C (3.116)."""
+        from damage_dolfinx.forms.fully_damageable import damaged_contact_pressure
+        return damaged_contact_pressure(self.u, self.zeta, self.n_facet, self.c_nu, self.gap,
+                                        self.params.zeta_star)
+
     def iteration_totals(self) -> dict:
         out = {"damage_snes": self.damage.iterations if self.damage else 0}
         if self.elastic_term == "explicit":

@@ -170,6 +170,11 @@ class ViscoelasticMemoryContact(Model):
         out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
         return out
 
+    def contact_pressure(self):
+        """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
+        from damage_dolfinx.numerics.contact import normal_compliance_pressure
+        return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)
+
     def iteration_totals(self) -> dict:
         return {"damage_ksp": self.damage.iterations, "snes": self.mech.iterations,
                 "mech_ksp": self.mech.linear_iterations,
