@@ -139,13 +139,13 @@ class DynamicKelvinVoigt(TimeStepper):
         action = x.get("stability_check", "warn")
         if action == "off":
             return {}
-        from damage_dolfinx.numerics.stability import check_time_step, estimate_stability
+        from damage_dolfinx.numerics.stability import checked, estimate_stability
         start = time.perf_counter()
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
-                                 bcs=self.bcs, normal=self.n_facet)
+                                 bcs=self.bcs, normal=self.n_facet, k=self.k)
         where = f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate"
-        out["k_over_k_max"] = check_time_step(self.k, out["k_max"], where, action=action)
+        checked(out, self.k, where, action)
         out["time_s"] = time.perf_counter() - start
         return out
 

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from . import primitives
 from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks,  # noqa: F401
                         is_damage, narrow_damage, shared_limits, si_unit)
 from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
@@ -99,10 +100,9 @@ def draw_outline(ax, ref_xy, label="undeformed outline"):
 
 
 def draw_mesh_edges(ax, xy, lw=None):
-    from matplotlib.collections import PolyCollection
+    from damage_dolfinx.viz.primitives import triangle_edges
     lw = lw or (0.35 if len(xy) < 3000 else 0.2)
-    ax.add_collection(PolyCollection(xy, facecolors="none", edgecolors="k", linewidths=lw,
-                                     zorder=2))
+    triangle_edges(ax, xy, colour="k", linewidth=lw, zorder=2)
 
 
 def _triangulation(xy):
@@ -157,11 +157,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
             else:
                 vmin, vmax = (limits or {}).get(i) or (0.0, float(np.nanmax(vals)) or 1.0)
                 cmap, label, note = STRESS_CMAP, mathtext(p.get("label", "")), ""
-            if vals.ndim == 2:
-                im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap=cmap,
-                                  vmin=vmin, vmax=vmax)
-            else:
-                im = ax.tripcolor(tri, facecolors=vals, cmap=cmap, vmin=vmin, vmax=vmax)
+            im = primitives.field(ax, tri, vals, cmap, vmin, vmax)
             ticks = damage_ticks(vmin, vmax, zeta_star) if damage and zeta_star is not None else None
             label, scale = si_unit(label, vmax) if not damage else (label, 1.0)
             cb = colorbar(fig, ax, im, label, ticks)
@@ -201,11 +197,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
 
 def _stretched_damage(fig, ax, tri, vals, lo, hi):
     """The same damage field on a colour scale stretched to its own range [lo, hi]."""
-    if vals.ndim == 2:
-        im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap=STRETCHED_CMAP,
-                          vmin=lo, vmax=hi)
-    else:
-        im = ax.tripcolor(tri, facecolors=vals, cmap=STRETCHED_CMAP, vmin=lo, vmax=hi)
+    im = primitives.field(ax, tri, vals, STRETCHED_CMAP, lo, hi)
     cb = colorbar(fig, ax, im, "$\\zeta$ (scale: range of the field)")
     plain_ticks(cb.ax.yaxis)
     ax.set_title(f"the same damage, colours stretched\nto its range [{lo:.3g}, {hi:.3g}]")
@@ -309,10 +301,10 @@ def draw_setting(ax, cells, parts, loads=(), note=""):
     colour, label, hatched)), load arrows (``loads``: ("f_N", segments, vectors, label) or
     ("f_B", points, vectors, label)); frames the axes on body, markers and arrows; ``note``
     (e.g. why a load is not drawn) goes under the legend."""
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.collections import LineCollection
     cells = np.asarray(cells)
-    ax.add_collection(PolyCollection(cells, facecolors="none", edgecolors="0.6",
-                                     linewidths=0.3 if len(cells) > 3000 else 0.5))
+    primitives.triangle_edges(ax, cells, colour="0.6", zorder=1,
+                              linewidth=0.3 if len(cells) > 3000 else 0.5)
     size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
     inside = inside_test(cells)
     extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
