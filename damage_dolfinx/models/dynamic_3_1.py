@@ -35,6 +35,7 @@ from mpi4py import MPI
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
@@ -164,9 +165,8 @@ class DynamicKelvinVoigt(TimeStepper):
     def u_max(self) -> float:
         """max over the nodes of |u_n| (the L-shape comparison of Example 3)."""
         owned = self.u.function_space.dofmap.index_map.size_local
-        u = self.u.x.array.reshape(-1, self.mesh.topology.dim)[:owned]
-        return self.comm.allreduce(float(np.linalg.norm(u, axis=1).max()) if owned else 0.0,
-                                   op=MPI.MAX)
+        d = self.mesh.topology.dim
+        return bookkeeping.max_node_norm(self.u.x.array[:owned * d], d, self.comm)
 
     def scalars(self) -> dict:
         out = super().scalars()
