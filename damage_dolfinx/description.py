@@ -102,8 +102,10 @@ class Example:
         base = self.literal or self
         r = base.readings.get(name, Reading()) if name != "literal" else Reading()
         label = "the default" if name == base.default_reading else "not the default"
-        departures = (f"{len(r.assumptions)} departure(s) from the stated data, listed as R-entries"
-                      if r.assumptions else "no departure from the stated data")
+        from damage_dolfinx.departures import departures as _departures
+        count = len(_departures(base.assumptions + r.assumptions))
+        departures = (f"{count} departure(s) from the stated data, listed as R-entries and "
+                      f"departure entries" if count else "no departure from the stated data")
         return dataclasses.replace(
             base, params=base.params.replace(**r.overrides),
             traction=r.traction or base.traction, body_force=r.body_force or base.body_force,

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+from damage_dolfinx import departures
 from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.runtime.cases import resolve
 from damage_dolfinx.numerics.damage import fast_path_counts
@@ -166,6 +167,7 @@ class Run(RunRecords):
             "history_every": self.options["history_every"],
             "steps_done": 0, "t_final": 0.0, "mpi_size": comm.size,
             "mesh": stepper.mesh_info(), "assumptions": ex.assumptions,
+            "reading": departures.record(ex),
             "outputs": {"xdmf": self.xdmf_name, "history": "history.csv",
                         "final_fields": "fields_final.npz", "figures": []},
             "environment": io.environment(comm)}
