@@ -23,7 +23,7 @@ Names are imported on first use, so ``import damage_dolfinx`` stays light.
 __version__ = "0.1.0"
 
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
-           "Model", "SubStep", "ProblemData", "register_model", "model_class",
+           "Model", "SubStep", "ProblemData", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
            "InputError"]
 
@@ -41,6 +41,8 @@ def __getattr__(name):
     if name == "MODELS":
         from damage_dolfinx.models.registry import MODELS
         return {key: m.title for key, m in MODELS.items()}
+    if name == "blocks":  # the building blocks of the models (a module)
+        return importlib.import_module("damage_dolfinx.blocks")
     if name == "register_model":
         from damage_dolfinx.models.registry import register
         return register

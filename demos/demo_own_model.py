@@ -161,6 +161,31 @@ if comm.rank == 0:
           f"load {-Q_LOAD * problem.T:.6g}")
     print(f"PHYSICS_CHECK contact_balance {imbalance:.3e} 1e-8 "
           f"{'PASS' if imbalance <= 1e-8 else 'FAIL'}")
+assert imbalance <= 1e-8
+
+# %%
+# The force on the foundation
+# ---------------------------
+# The history of the run (its column ``contact_force``, declared by the model), across the
+# stop and the restart, against the load :math:`q t`.
+
+if comm.rank == 0:
+    import csv
+
+    import matplotlib.pyplot as plt
+    with open(out / "run" / "history.csv") as f:
+        rows = list(csv.DictReader(f))
+    t = np.array([float(r["t"]) for r in rows])
+    force = -np.array([float(r["contact_force"]) for r in rows])
+    fig, ax = plt.subplots(figsize=(5.5, 3.4))
+    ax.plot(t, Q_LOAD * t, "-", color="0.6", label="load $q\\,t$")
+    ax.plot(t, force, "o", label=r"foundation: $-\int_{\Gamma_C} p_\nu \nu_y$")
+    ax.axhline(7.5, ls=":", color="C3", label="the monitor's stop")
+    ax.set_xlabel("time $t$")
+    ax.set_ylabel("vertical force")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out / "contact_force.png", dpi=120)
 
 # %%
 # Convergence and a sweep
