@@ -307,6 +307,20 @@ def _check_finite(args):
                 raise InputError(f"--{name.replace('_', '-')} must be a finite number, got {v}")
 
 
+def _load_plugins():
+    """Import the modules named in DAMAGE_DOLFINX_PLUGINS (comma-separated): they may register
+    models (damage_dolfinx.register_model), friction solvers or case sources before the run."""
+    import importlib
+    from damage_dolfinx.parameters import InputError
+    for name in filter(None, (n.strip() for n in os.environ.get("DAMAGE_DOLFINX_PLUGINS",
+                                                                  "").split(","))):
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            raise InputError(f"DAMAGE_DOLFINX_PLUGINS names {name!r}, which cannot be "
+                             f"imported: {exc}") from None
+
+
 def main(argv=None):
     comm = MPI.COMM_WORLD
     from damage_dolfinx.parameters import InputError
@@ -320,6 +334,7 @@ def main(argv=None):
         given = _petsc_options(extra, parser, args.command)
         _check_finite(args)
         _check_petsc_values(given)
+        _load_plugins()
         from damage_dolfinx.catalogue import examples  # the catalogue's ids (runtime/cases.py)
         if args.command == "list":
             if comm.rank == 0:

@@ -122,7 +122,7 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
     """The geometry with its facet tags renamed to the roles the models read (1 clamped,
     2 traction, 3 contact), from ``boundaries`` = {role: tag or tags}; None keeps the tags as
     they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty.
-    ``model``: the model class, whose ``contact_roles`` are the contact roles allowed."""
+    ``model``: the model class, whose ``boundary_roles()`` are the roles allowed."""
     from damage_dolfinx import compat
     from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION
     counts = tag_counts(geometry)
@@ -132,8 +132,9 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
             raise InputError(f"{where}: the {what} tag {tag} is missing or empty")
     if boundaries is None:
         return geometry
-    allowed = ("clamped", "traction") + (model.contact_roles if model else CONTACT_ROLES)
-    internal = {"clamped": CLAMPED, "traction": TRACTION}
+    internal = model.boundary_roles() if model else \
+        {"clamped": CLAMPED, "traction": TRACTION, **{r: CONTACT for r in CONTACT_ROLES}}
+    allowed = tuple(internal)
     mapping = {}
     for role, tags in boundaries.items():
         if role not in allowed:
@@ -145,7 +146,7 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
                                  f"(tags present: {sorted(counts) or 'none'})")
             if int(tag) in mapping:
                 raise InputError(f"facet tag {int(tag)} is given two roles")
-            mapping[int(tag)] = internal.get(role, CONTACT)
+            mapping[int(tag)] = internal[role]
     ft = geometry.facet_tags
     keep = np.isin(ft.values, list(mapping))
     values = np.array([mapping[int(v)] for v in ft.values[keep]], dtype=np.int32)
