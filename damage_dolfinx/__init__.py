@@ -8,6 +8,8 @@ The public face (everything else is internal and may change):
   folder, study its convergence, run it over a grid of parameter values, gather a field on
   rank 0;
 * :class:`DamageLaw` and the thesis laws :data:`THESIS_A`, :data:`THESIS_B`;
+* :func:`read_run`: a run folder back into a script (summary, history arrays, fields at any
+  stored time);
 * :func:`read_mesh`, :func:`from_gmsh`: meshes from gmsh files or models;
 * :class:`ModelParameters` (material, damage and model data), :class:`InputError`;
 * the packages :mod:`damage_dolfinx.geometries` (mesh builders) and :mod:`damage_dolfinx.forms`
@@ -19,12 +21,12 @@ __version__ = "0.1.0"
 
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "converge", "sweep", "gather",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
-           "InputError"]
+           "InputError", "read_run"]
 
 _WHERE = {"Problem": "problem", "run": "workflow", "converge": "workflow",
           "sweep": "studies.sweep", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
           "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
-          "ModelParameters": "parameters", "InputError": "parameters"}
+          "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results"}
 
 
 def __getattr__(name):

@@ -139,7 +139,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             return previous
     xdmf_name = f"fields_from_step{resume[1]['step']}.xdmf" if resume else "fields.xdmf"
     planned = {"summary.json", "history.csv", xdmf_name, xdmf_name[:-5] + ".h5",
-               xdmf_name + ".bak", "fields_final.npz", "checkpoint.json",
+               xdmf_name + ".bak", "fields.xdmf", "fields.xdmf.tmp", "fields_final.npz", "checkpoint.json",
                *checkpoint.GENERATIONS, *(fig.filename for fig in ex.figures if figures)}
     description = previous["description"] if previous else None
     claim_folder(out, "run", planned, restart, overwrite, comm, description, apply=False)
@@ -178,17 +178,18 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                "outputs": {"xdmf": "fields.xdmf", "history": "history.csv",
                            "final_fields": "fields_final.npz", "figures": []},
                "environment": io.environment(comm)}
-    summary["outputs"]["xdmf"] = xdmf_name
     files = {}  # the XDMF series and the history, created below (collectively checked)
     columns = ["step", "t", "u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean",
                "damage_its", "mech_its", "snes_its", "step_time_s", *stepper.extra_history_columns]
 
     def open_files():
-        files["xdmf"] = io.XDMFSeries(out / xdmf_name, stepper.mesh)
+        files["xdmf"] = io.XDMFSeries(out / xdmf_name, stepper.mesh, out / "fields.xdmf",
+                                      resume["t"] if resume else None)
         files["history"] = io.CSVHistory(out / "history.csv", columns, comm,
                                          keep_until_step=resume["step"] if resume else None)
     io.collective(comm, out, f"{xdmf_name} / history.csv (opening)", open_files)
     xdmf, history = files["xdmf"], files["history"]
+    summary["outputs"].update(io.series_outputs(xdmf))
     report = Progress(ex.id, N, comm, enabled=progress)
     # steppers without track() compute their scalars (whatever they keep track of stays right)
     track = getattr(stepper, "track", None) or stepper.scalars
