@@ -5,6 +5,7 @@
     run.history["t"], run.history["zeta_min"]                    # history.csv, one array a column
     run.times                                                    # the stored times of fields.xdmf
     f = run.field("zeta", t=0.5)                                 # f.t, f.coords, f.values
+    run.integral("v", t=0.5)                                     # int_Omega v dx (per component)
     run.final["zeta"]                                            # fields_final.npz
 
 Fields come in the rank-independent order of ``fields_final.npz`` (nodes, or cell midpoints for
@@ -68,6 +69,11 @@ class RunResults:
         """Field ``name`` at the stored time nearest ``t`` (default: the last one)."""
         coords, values, t_found = self.series.field(name, t)
         return Field(name, t_found, coords, values)
+
+    def integral(self, name: str, t: float = None) -> np.ndarray:
+        """int_Omega of field ``name`` at the stored time nearest ``t`` (default: the last),
+        one value per component (exact for P1 and cell fields on triangles and tetrahedra)."""
+        return self.series.integral(name, t)
 
     @property
     def final(self) -> dict:

@@ -103,7 +103,22 @@ free_fall = float(np.max(np.abs(v[in_air] / (g * t[in_air] * np.sqrt(area)) - 1)
 stored = 0.5 * c_nu * width * rms**2
 work_bound = rho * area * g * u_max
 ratio = float(np.max(stored[1:] / work_bound[1:]))
-checks = [("free_fall", free_fall, 1e-10), ("energy_bound", max(ratio - 1, 0.0), 1e-12)]
+# * Momentum: the foundation's force (``contact_force_y``, a contact output of every model)
+#   and gravity change the block's momentum :math:`\int_\Omega \rho v_y`: the scheme uses
+#   the force of step :math:`n - 1` in step :math:`n`, so
+#   :math:`\rho \int_\Omega v_y(T) = k \sum_{n<N} F_{y,n} - m g T`. The block bounces, it
+#   is never at rest: this is the balance of the contact resultant and the load over the run.
+#   :func:`damage_dolfinx.read_run` gives :math:`\int_\Omega v` at the last stored time.
+mass = rho * area
+impulse = k * history["contact_force_y"][:-1].sum() - mass * g * t[-1]
+momentum = rho * dd.read_run(out).integral("v")[1]
+momentum_balance = abs(impulse - momentum) / (mass * g * t[-1])
+checks = [("free_fall", free_fall, 1e-10), ("energy_bound", max(ratio - 1, 0.0), 1e-12),
+          ("momentum_balance", momentum_balance, 1e-8)]
+if comm.rank == 0:
+    print(f"contact impulse - m g T = {impulse:.10g}, final momentum = {momentum:.10g}; "
+          f"contact force at T: {history['contact_force_y'][-1]:.6g} (weight m g = "
+          f"{mass * g:g})")
 if comm.rank == 0:
     print(f"largest share of the work of gravity stored in the foundation: {ratio:.3f} "
           f"(at t = {t[1:][np.argmax(stored[1:] / work_bound[1:])]:.4f})")

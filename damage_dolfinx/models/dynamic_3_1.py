@@ -41,6 +41,7 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput, normal_compliance_pressure
 
 
 #: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
@@ -112,6 +113,7 @@ class DynamicKelvinVoigt(TimeStepper):
         self._scalar_setup(ds(GAMMA_C))
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises, self.von_mises_strain]
         self.timings = {"damage": 0.0, "velocity": 0.0, "stability": self.stability.get("time_s", 0.0)}
+        ContactOutput.attach(self, pressure=normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap), gap=self.gap)
 
     # -- the scheme
     def _initial_state(self) -> dict:

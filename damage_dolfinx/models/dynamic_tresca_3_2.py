@@ -34,6 +34,7 @@ from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import check_time_step, estimate_k_max
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput
 
 
 class DynamicTresca(TimeStepper):
@@ -88,6 +89,7 @@ class DynamicTresca(TimeStepper):
         self._vm_expr = compat.expression(von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "friction": 0.0}
+        ContactOutput.attach(self, residual=ufl.action(a, self.v) - l, slip_rate=self.v, eps_slip=x["eps_reg"])
 
     # -- the scheme
     def _initial_state(self) -> dict:

@@ -35,6 +35,7 @@ from damage_dolfinx.numerics.solvers import LinearSolver, lagged_direct
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput
 
 
 class ElasticDamage(TimeStepper):
@@ -85,6 +86,7 @@ class ElasticDamage(TimeStepper):
             von_mises(stress(self.u, self.zeta, p.E, p.nu, p.zeta_star)), Q)
         self.output_fields = [self.u, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "mech": 0.0}  # seconds per sub-step, whole run
+        ContactOutput.attach(self, residual=ufl.action(a, self.u) - L)  # bilateral Gamma_C
 
     def _initial_state(self) -> dict:
         self.interpolate_zeta0(self.zeta)

@@ -52,6 +52,7 @@ from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
 from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
 from damage_dolfinx.numerics.zeta_linear import VelocitySolver
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput, normal_compliance_pressure
 
 #: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
 #: VELOCITY_EXTRAPOLATION);
@@ -158,6 +159,7 @@ class FullyDamageableContact(TimeStepper):
             line = line.get(choice)
         self.profiles = DamageProfiles(Z, line, data.builders.get("profile_every", 0.5), self.k)
         self.extra_history_columns = (["v_L2"] + self.contact.columns + self.probe.columns)
+        ContactOutput.attach(self, pressure=self.zeta * normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap), gap=self.gap)
         self.timings = {"damage": 0.0, "velocity": 0.0,
                         "stability": self.stability.get("time_s", 0.0)}
 

@@ -32,6 +32,7 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput
 
 
 class KelvinVoigtTresca(TimeStepper):
@@ -71,6 +72,7 @@ class KelvinVoigtTresca(TimeStepper):
         self._vm_expr = compat.expression(von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "friction": 0.0}
+        ContactOutput.attach(self, residual=ufl.action(a, self.v) - l, slip_rate=self.v, eps_slip=x["eps_reg"])
 
     # -- the scheme
     def _initial_state(self) -> dict:
@@ -112,7 +114,7 @@ class KelvinVoigtTresca(TimeStepper):
 
     def scalars(self) -> dict:
         out = super().scalars()
-        if not self.extra_history_columns:
+        if not hasattr(self, "_probe"):
             return out
         nodes, i, residual, r = self._probe  # R(w) = a(v, w) - l(w) = -sum_i m_i Phi_i w_tau,i
         with r.localForm() as rl:

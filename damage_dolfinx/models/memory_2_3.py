@@ -35,6 +35,7 @@ from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput, normal_compliance_pressure
 
 
 #: Krylov iterations above which the lagged Jacobian factorisation is rebuilt
@@ -125,6 +126,7 @@ class ViscoelasticMemoryContact(TimeStepper):
         self._stress_sq = compat.form(ufl.inner(sigma, sigma) * ufl.dx)
         self.output_fields = [self.u, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "memory": 0.0, "mech": 0.0}
+        ContactOutput.attach(self, pressure=normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap), gap=self.gap)
 
     def checkpoint_state(self) -> dict:
         """u, zeta and the memory M_n (running/recursive modes keep no other history)."""

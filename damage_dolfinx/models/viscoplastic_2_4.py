@@ -31,6 +31,7 @@ from damage_dolfinx.numerics.cellwise_stress import StressUpdate
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.contact_output import ContactOutput
 
 FRICTION_LAWS = ("tresca", "coulomb")
 
@@ -97,6 +98,7 @@ class ElastoViscoplasticFriction(TimeStepper):
         if x.get("stress_in_error", "yes") == "no":  # e_hk without ||sigma||_Q
             self.error_components = [c for c in self.error_components if c[0] != "sigma"]
         self.timings = {"damage": 0.0, "friction": 0.0, "stress": 0.0}
+        ContactOutput.attach(self, residual=ufl.action(a, self.w) - l, slip_rate=self.w, eps_slip=x["eps_reg"])
 
     @staticmethod
     def _gamma_c_dofs(V, tags):

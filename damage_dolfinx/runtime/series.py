@@ -145,3 +145,29 @@ class Series:
         coords, values = coords[first], values[first]
         order = np.lexsort(key.T[::-1])
         return coords[order], values[order], t_found
+
+    def integral(self, name, t=None):
+        """int_Omega f dx of field ``name`` (a node field: P1, exact cell by cell as |T| times
+        the mean of its vertex values on triangles and tetrahedra; a cell field: sum |T| f_T),
+        per component, at the stored time nearest ``t``."""
+        steps = self.steps[name]
+        t = steps[-1][0] if t is None else float(t)
+        _, grid = min(steps, key=lambda s: abs(s[0] - t))
+        folder = self.path.parent
+        x = _dataset(folder, grid.find("Geometry/DataItem"))
+        cells = _dataset(folder, grid.find("Topology/DataItem")).astype(np.int64)
+        attribute = grid.find("Attribute")
+        values = _dataset(folder, attribute.find("DataItem"))
+        values = values[:, None] if values.ndim == 1 else values
+        edges = x[cells[:, 1:]] - x[cells[:, :1]]  # (cells, dim, gdim)
+        if edges.shape[1] == 2 and x.shape[1] == 2:
+            size = 0.5 * np.abs(edges[:, 0, 0] * edges[:, 1, 1] - edges[:, 0, 1] * edges[:, 1, 0])
+        elif edges.shape[1] == 3:
+            size = np.abs(np.linalg.det(edges)) / 6.0
+        else:
+            raise ValueError("integral: triangles and tetrahedra only")
+        per_cell = values if attribute.get("Center") == "Cell" else values[cells].mean(axis=1)
+        total = size @ per_cell
+        if attribute.get("AttributeType") == "Vector" and total.size == 3 and x.shape[1] == 2:
+            total = total[:2]
+        return total
