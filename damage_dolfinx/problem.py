@@ -47,7 +47,8 @@ class Problem:
         k: time step (None: the largest below 0.8 k_max and T/100 that divides T; for the
             dynamic models k must be given). A k above the scheme's stability limit k_max is
             refused unless ``allow_unstable``; :meth:`k_max` gives the limit before the run.
-        boundaries: ``{role: tag or [tags]}``; roles ``clamped`` (u = 0), ``traction``
+        boundaries: ``{role: tag or [tags]}``, a tag a number or a gmsh physical name
+            (``{"clamped": "left"}``: a mesh read from gmsh); roles ``clamped`` (u = 0), ``traction``
             (the traction acts there), and the model's contact role: ``bilateral`` (2.1,
             u.nu = 0), ``tresca`` (2.2, 2.4 P1, 3.2: bilateral contact, Tresca friction bound
             ``g_fric``), ``coulomb`` (2.4 P2: simplified Coulomb, normal stress ``S_n``, bound
