@@ -320,8 +320,8 @@ def main(argv=None):
         given = _petsc_options(extra, parser, args.command)
         _check_finite(args)
         _check_petsc_values(given)
+        from damage_dolfinx.catalogue import examples  # the catalogue's ids (runtime/cases.py)
         if args.command == "list":
-            from damage_dolfinx.catalogue import examples
             if comm.rank == 0:
                 for ex in examples.catalogue().values():
                     reading = f" (reading: {ex.reading})" if ex.readings else ""

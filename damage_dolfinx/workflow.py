@@ -5,6 +5,14 @@ from __future__ import annotations
 from mpi4py import MPI
 
 
+def _named(problem):
+    """A catalogue id needs the catalogue loaded (it registers its ids with the run machinery,
+    which does not import it)."""
+    if isinstance(problem, str):
+        import damage_dolfinx.catalogue  # noqa: F401
+    return problem
+
+
 def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
         checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
@@ -22,7 +30,7 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     work; a solver that fails raises ConvergenceError after marking the summary "failed".
     """
     from damage_dolfinx.runtime.runner import run as _run
-    return _run(problem, out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+    return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
                 checkpoint_every=checkpoint_every, progress=progress, figures=figures,
                 comm=comm)
 
@@ -36,7 +44,7 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     coarse solutions are transferred to the reference mesh exactly. Every n must divide
     ``ref_n`` and every k must be a multiple of ``ref_k``."""
     from damage_dolfinx.studies.convergence import study
-    return study(problem, out, ref_n=ref_n, ref_k=ref_k, ns=list(n), ks=list(k), T=T,
+    return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=list(n), ks=list(k), T=T,
                  progress=progress, comm=comm)
 
 
@@ -46,3 +54,16 @@ def gather(function):
     parallel one compare entry by entry; ``None`` on the other ranks (collective)."""
     from damage_dolfinx.runtime.io import gather_dof_field
     return gather_dof_field(function)
+
+
+def sweep(problem, out, grid, **kwargs) -> dict:
+    from damage_dolfinx.studies.sweep import sweep as _sweep
+    return _sweep(_named(problem), out, grid, **kwargs)
+
+
+def _sweep_doc():
+    from damage_dolfinx.studies.sweep import sweep as _sweep  # light: no DOLFINx import
+    return _sweep.__doc__
+
+
+sweep.__doc__ = _sweep_doc()

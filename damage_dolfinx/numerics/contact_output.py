@@ -1,7 +1,7 @@
 """Contact quantities as outputs: what the foundation does to the body on Gamma_C, per step.
 
-One object for every model with a contact role (``ContactOutput.attach(stepper, ...)``, one line
-in the model): it adds history.csv columns and XDMF fields to the stepper.
+One object for every model with a contact role: the run attaches it to its model
+(``ContactOutput.for_model``), which adds history.csv columns and XDMF fields to the model.
 
 Nodal contact forces. With the vertex (trapezoidal) rule on Gamma_C, node i of Gamma_C carries
 the weight m_i = int_{Gamma_C} phi_i ds, the lumped unit normal nu_i (int nu phi_i ds,
@@ -82,7 +82,7 @@ class ContactOutput:
         dsq = ufl.Measure("ds", domain=msh, subdomain_data=tags,
                           metadata={"quadrature_degree": PRESSURE_DEGREE})
         force = -pressure * ufl.dot(n, w) * dsq(GAMMA_C) if self.compliance else residual
-        self._force = compat.form(force)
+        self._force = force if isinstance(force, tuple) else compat.form(force)
         self.slip_rate, self.eps_slip = slip_rate, eps_slip
         size = "length" if self.dim == 2 else "area"
         self.columns = (["contact_normal_force"] + [f"contact_force_{c}" for c in "xyz"[:bs]]
@@ -124,11 +124,57 @@ class ContactOutput:
         stepper.contact_output = out
         return out
 
+    @classmethod
+    def for_model(cls, stepper):
+        """Attach the contact outputs that fit ``stepper`` (a model): normal compliance when it
+        has a contact pressure (``contact_pressure()``), the reaction and friction of its
+        friction problem (``friction_problem``: a, l, v), the reaction of its linear mechanical
+        solve (``mech``: a, L of a bilateral Gamma_C); nothing otherwise."""
+        pressure = stepper.contact_pressure() if hasattr(stepper, "contact_pressure") else None
+        if pressure is not None:
+            gap = float(stepper.params.extra.get("gap", 0.0))
+            return cls.attach(stepper, pressure=pressure, gap=gap)
+        problem = getattr(stepper, "friction_problem", None)
+        if problem is not None:
+            return cls.attach(stepper, residual=ufl.action(problem.a, problem.v) - problem.l,
+                              slip_rate=problem.v,
+                              eps_slip=float(stepper.params.extra.get("eps_reg", 1e-9)))
+        mech = getattr(stepper, "mech", None)
+        if "bilateral" in getattr(stepper, "contact_roles", ()) and hasattr(mech, "a") \
+                and hasattr(mech, "L"):
+            return cls.attach(stepper, residual=(mech.a, mech.L))
+        return None
+
     def _nodal(self):
         """(F (nodes, dim), p (nodes,), F_tau (nodes, dim)) on the owned contact nodes."""
-        F = _assemble(self._force).reshape(-1, self.dim)[self.nodes]
+        F = self._forces().reshape(-1, self.dim)[self.nodes]
         Fn = np.sum(F * self.nu, axis=1)
         return F, -Fn / self.m[self.nodes], F - Fn[:, None] * self.nu
+
+    def _forces(self):
+        """Owned entries of the nodal force vector: an assembled linear form, or A u - b of a
+        compiled (a, L) pair (a linear solve's forms, without its boundary conditions)."""
+        if not isinstance(self._force, tuple):
+            return _assemble(self._force)
+        a, L = self._force
+        if not hasattr(self, "_matrix"):
+            self._matrix = compat.create_matrix(a)
+        A = self._matrix
+        A.zeroEntries()
+        compat.assemble_matrix(A, a, [])
+        A.assemble()
+        r = A.createVecLeft()
+        A.mult(compat.petsc_vec(self.u), r)
+        b = compat.create_vector(L)
+        with b.localForm() as local:
+            local.set(0.0)
+        compat.assemble_vector(b, L)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        r.axpy(-1.0, b)
+        out = r.getArray().copy()
+        r.destroy()
+        b.destroy()
+        return out
 
     def scalars(self) -> dict:
         F, p, F_tau = self._nodal()
