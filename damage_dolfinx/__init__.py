@@ -11,7 +11,10 @@ The public face (everything else is internal and may change):
 * :func:`read_run`: a run folder back into a script (summary, history arrays, fields at any
   stored time);
 * :func:`read_mesh`, :func:`from_gmsh`: meshes from gmsh files or models;
-* :class:`ModelParameters` (material, damage and model data), :class:`InputError`;
+* :class:`ModelParameters` (material, damage and model data);
+* the exceptions :class:`InputError` (bad input, refused before any work),
+  :class:`ConvergenceError` (a solver failed), :class:`OutputError` (an output could not be
+  written), :class:`RunInterrupted` (stopped by a signal, with a checkpoint): damage_dolfinx.errors;
 * the packages :mod:`damage_dolfinx.geometries` (mesh builders) and :mod:`damage_dolfinx.forms`
   (the weak forms in UFL).
 
@@ -21,12 +24,14 @@ __version__ = "0.1.0"
 
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "converge", "sweep", "gather",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
-           "InputError", "read_run"]
+           "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run"]
 
 _WHERE = {"Problem": "problem", "run": "workflow", "converge": "workflow",
           "sweep": "workflow", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
           "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
-          "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results"}
+          "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results",
+          "ConvergenceError": "numerics.solvers", "OutputError": "runtime.atomic",
+          "RunInterrupted": "runtime.signals"}
 
 
 def __getattr__(name):

@@ -49,14 +49,14 @@ class Run(RunRecords):
         if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
                 or every < 1:
             raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
-        for name, value in (("--write-every", write_every),
-                            ("--checkpoint-every", checkpoint_every)):
+        for name, value in (("write_every", write_every),
+                            ("checkpoint_every", checkpoint_every)):
             if value is not None and (isinstance(value, bool) or not isinstance(value, int)
                                       or value < 1):
                 raise InputError(f"{name} must be a whole number >= 1, got {value!r}")
         if not (isinstance(checkpoint_seconds, (int, float)) and checkpoint_seconds >= 0
                 and math.isfinite(checkpoint_seconds)):
-            raise InputError(f"--checkpoint-seconds must be a finite number >= 0 (0: none), "
+            raise InputError(f"checkpoint_seconds must be a finite number >= 0 (0: none), "
                              f"got {checkpoint_seconds!r}")
         if mesh_file is not None:
             check_mesh_file(mesh_file, ex.dim, lambda: ex.mesh_requirements()[1], comm=comm)
@@ -106,13 +106,14 @@ class Run(RunRecords):
                     print(f"damage-dolfinx: nothing to do: the run in {str(self.out)!r} ended "
                           f"({previous['status']}) at t = {previous['t_final']:.6g} after "
                           f"{previous['steps_done']} steps; its outputs are unchanged"
-                          + (" (a larger --T continues it)" if previous["status"] == "completed"
+                          + (" (a larger T continues it)" if previous["status"] == "completed"
                              else ""), flush=True)
                 self.summary = previous
                 return False
         self.xdmf_name = f"fields_from_step{resume[1]['step']}.xdmf" if resume else "fields.xdmf"
         planned = {"summary.json", "history.csv", self.xdmf_name, self.xdmf_name[:-5] + ".h5",
-                   self.xdmf_name + ".bak", "fields.xdmf", "fields.xdmf.tmp", "fields_final.npz", "checkpoint.json",
+                   self.xdmf_name + ".bak", "fields.xdmf", "fields.xdmf.tmp", "fields_final.npz",
+                   "checkpoint.json",
                    *checkpoint.GENERATIONS, *(fig.filename for fig in ex.figures
                                                if o["figures"])}
         description = previous["description"] if previous else None

@@ -120,7 +120,8 @@ class Series:
         in the rank-independent order of fields_final.npz (sorted by x, then y (then z)); cell
         fields at the cell midpoints; 2-D vectors without XDMF's zero third component."""
         if name not in self.steps:
-            raise KeyError(f"no field {name!r} in {self.path.name}; fields: {', '.join(self.names)}")
+            raise KeyError(f"no field {name!r} in {self.path.name}; fields: "
+                           f"{', '.join(self.names)}")
         steps = self.steps[name]
         t = steps[-1][0] if t is None else float(t)
         t_found, grid = min(steps, key=lambda s: abs(s[0] - t))
