@@ -322,6 +322,7 @@ def _load_plugins():
 
 
 def main(argv=None):
+    from damage_dolfinx.errors import for_command_line
     comm = MPI.COMM_WORLD
     from damage_dolfinx.parameters import InputError
     from damage_dolfinx.numerics.solvers import ConvergenceError
@@ -372,15 +373,18 @@ def main(argv=None):
         return 0
     except InputError as exc:
         if comm.rank == 0:
-            print(f"damage-dolfinx: error: {exc}", file=sys.stderr, flush=True)
+            print(f"damage-dolfinx: error: {for_command_line(str(exc))}", file=sys.stderr,
+                  flush=True)
         return 2
     except ConvergenceError as exc:
         if comm.rank == 0:
-            print(f"damage-dolfinx: solver failure: {exc}", file=sys.stderr, flush=True)
+            print(f"damage-dolfinx: solver failure: {for_command_line(str(exc))}", file=sys.stderr,
+                  flush=True)
         return 3
     except OutputError as exc:
         if comm.rank == 0:
-            print(f"damage-dolfinx: output error: {exc}", file=sys.stderr, flush=True)
+            print(f"damage-dolfinx: output error: {for_command_line(str(exc))}", file=sys.stderr,
+                  flush=True)
         from damage_dolfinx.runtime.io import FAILED_HDF5_FILES
         if FAILED_HDF5_FILES:  # HDF5 would crash shutting down the failed file
             sys.stdout.flush()
@@ -393,7 +397,7 @@ def main(argv=None):
         for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out
             signal.signal(s, signal.SIG_IGN)
         if comm.rank == 0:
-            print(f"damage-dolfinx: {exc}", file=sys.stderr, flush=True)
+            print(f"damage-dolfinx: {for_command_line(str(exc))}", file=sys.stderr, flush=True)
         return exc.exit_status
     finally:
         _forget(given)

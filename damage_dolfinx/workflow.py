@@ -27,11 +27,23 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     larger ``T`` continues a completed run); a folder that already holds a run is refused
     unless ``restart`` or ``overwrite``. SIGTERM/SIGINT stop the run at the end of a step with a
     checkpoint. Under ``mpirun`` every rank calls it; only rank 0 prints. ``n``, ``k``, ``T``
-    override the problem's own. Bad input raises :class:`~damage_dolfinx.InputError` before any
-    work; a solver that fails raises ConvergenceError after marking the summary "failed".
+    override the problem's own. ``fields.xdmf`` is one time series from t = 0 to the last step
+    whatever restarts happened; :func:`~damage_dolfinx.read_run` reads the folder back.
     ``on_step(step)``: called after the initial state and after every step with the
     :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
     the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
+
+    Raises (all importable from ``damage_dolfinx``; damage_dolfinx.errors):
+
+    * :class:`~damage_dolfinx.InputError`: bad input, refused before any work (one line; a
+      folder holding a run without ``restart=True`` or ``overwrite=True``, a k above
+      ``problem.k_max()``, an unknown boundary name, ...);
+    * :class:`~damage_dolfinx.ConvergenceError`: a solver did not converge or a field became
+      NaN/inf or left [zeta*, 1]; summary.json says "failed", the finished steps stay;
+    * :class:`~damage_dolfinx.OutputError`: an output could not be written (full disk, I/O
+      error); summary.json says "failed" where space allows;
+    * :class:`~damage_dolfinx.RunInterrupted`: SIGTERM, SIGINT or SIGUSR1 stopped the run at the
+      end of a step after a checkpoint (summary.json "interrupted"; ``restart=True`` goes on).
     """
     from damage_dolfinx.runtime.runner import run as _run
     return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,

@@ -415,6 +415,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
         write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
         label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
         plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k, definition)
-        print((out / "errors.md").read_text(), flush=True)
+        if progress:  # progress=False prints nothing
+            print((out / "errors.md").read_text(), flush=True)
     io.write_json(out / "summary.json", summary, comm)
     return summary

@@ -148,7 +148,7 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     if existing is not None and {key: existing.get(key) for key in mapping} != \
             json.loads(json.dumps(mapping)):
         raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
-                         "T in its points.json); choose another --out")
+                         "T in its points.json); choose another out folder")
     out = io.prepare_output_dir(out, comm)
     if comm.rank == 0:
         io.write_json(out / "points.json", mapping, comm)
