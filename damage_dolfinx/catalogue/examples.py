@@ -196,6 +196,8 @@ class Example:
         geometry = retag(geometry, self.boundaries, required, self.model)
         data = ProblemData(self.id, geometry, params, time, self.body_force, self.traction,
                            self.zeta0, self.builders, self.damage_law, self.irreversible)
+        from damage_dolfinx.validation import check_data
+        check_data(data)  # loads, law, zeta0 against the mesh (validation.py)
         from damage_dolfinx.models.registry import model as model_info
         return model_info(self.model).stepper_class()(data)
 
