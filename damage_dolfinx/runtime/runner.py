@@ -154,6 +154,7 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
                               "cannot set up the solvers")
     except ConvergenceError as exc:
         raise InputError(str(exc)) from None
+    settings["fingerprint"] = checkpoint.verify_fingerprint(ex, stepper, resume, out)
     claim_folder(out, "run", planned, restart, overwrite, comm, description)
     if (resume or checkpoint_every) and not stepper.checkpoint_supported:
         raise InputError(f"example {ex.id} does not support checkpoints")
