@@ -303,7 +303,8 @@ def _run(ex, configured, out, n, k, T, h, overrides, write_every, progress, figu
             checkpoint.load(path, stepper.checkpoint_state())
             stepper.restore(resume["step"])
             check_state()
-            stats, scalars = {}, stepper.scalars()
+            stats = {}
+            scalars = record(stats, 0.0, row=False)  # the summary from the state on disk
             write_fields()
         else:
             stats = solver_step(stepper.initialize, at("the initial solve"))
