@@ -289,17 +289,25 @@ def check_data(data):
         value = _call(f"damage_law {law.name!r}", "(eps, zeta, params)", law, e, z, data.params)
         _expect_shape(f"damage_law {law.name!r}", value, (), "a UFL scalar")
     z0 = data.zeta0
-    if callable(z0):
-        pts = np.zeros((3, 2))
-        pts[:, 1] = 1.0
+    if callable(z0):  # at the mesh nodes, where the P1 interpolation takes it
+        from mpi4py import MPI
+        pts = np.ascontiguousarray(msh.geometry.x.T)
+        pts = pts[:gdim] if gdim < 3 else pts
         try:
-            values = np.asarray(z0(pts[:gdim] if gdim < 3 else pts), dtype=float)
+            values = np.asarray(z0(pts), dtype=float)
         except Exception as exc:  # noqa: BLE001 - a user function: named, one line
             raise InputError(f"zeta0(x) raised {type(exc).__name__}: {exc} (x: a NumPy array of "
                              f"shape ({gdim}, N))") from None
-        if values.shape not in ((2,), (1, 2)):
+        if values.shape not in ((pts.shape[1],), (1, pts.shape[1])):
             raise InputError(f"zeta0(x) must return one value per point (shape (N,)), got "
-                             f"shape {values.shape} for N = 2")
+                             f"shape {values.shape} for N = {pts.shape[1]}")
+        comm = msh.comm
+        lo = comm.allreduce(float(np.min(values)) if values.size else np.inf, op=MPI.MIN)
+        hi = comm.allreduce(float(np.max(values)) if values.size else -np.inf, op=MPI.MAX)
+        zs = data.params.zeta_star
+        if not (np.isfinite(lo) and np.isfinite(hi)) or lo < zs - 1e-12 or hi > 1.0 + 1e-12:
+            raise InputError(f"zeta0(x) must lie in [zeta_star, 1] = [{zs:g}, 1] at every mesh "
+                             f"node, got values in [{lo:.4g}, {hi:.4g}]")
 
 
 def _time_constant(msh):

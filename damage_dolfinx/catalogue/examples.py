@@ -154,7 +154,9 @@ class Example:
         if h is not None and not h > 0:
             raise InputError(f"mesh size h must be positive, got h = {h}")
         if mesh_file is not None and not Path(mesh_file).is_file():
-            raise InputError(f"mesh file {str(mesh_file)!r} does not exist")
+            from damage_dolfinx.validation import mesh_path_problem
+            raise InputError(f"mesh file {str(mesh_file)!r} "
+                             f"{mesh_path_problem(Path(mesh_file)) or 'is not a file'}")
         if time.num_steps > MAX_STEPS and not allow_long:
             raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
                              f"{MAX_STEPS:.0e}; choose a larger k, or --allow-long")

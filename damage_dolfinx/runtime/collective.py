@@ -111,6 +111,27 @@ def line(exc, rank=None) -> str:
     return f"damage-dolfinx: {kind + ': ' if kind else ''}{text}{where}"
 
 
+#: folders this process created (removed again, if still empty, when the call is refused)
+_CREATED: list = []
+
+
+def created(folder):
+    _CREATED.append(Path(folder))
+
+
+def _tidy(exc, rank):
+    """A refused call leaves no empty folder it created."""
+    from damage_dolfinx.parameters import InputError
+    folders, _CREATED[:] = list(_CREATED), []
+    if rank != 0 or not isinstance(exc, InputError):
+        return
+    for folder in reversed(folders):
+        try:
+            folder.rmdir()  # only if empty
+        except OSError:
+            pass
+
+
 def track(folder, kind="run"):
     """Note a folder this process writes into (its summary.json receives a failure's status)."""
     _FOLDERS.append((Path(folder), kind))
@@ -155,11 +176,13 @@ def outcome(comm=MPI.COMM_WORLD):
             if comm.size == 1 and _LOCAL.depth == 1:
                 for folder, _ in _FOLDERS[start:]:
                     mark(folder, exc)
+                _tidy(exc, 0)
             raise
         finally:
             _LOCAL.depth -= 1
             if _LOCAL.depth == 0:
                 del _FOLDERS[start:]
+                _CREATED.clear()
         return
     agree = comm.Dup()
     _LOCAL.depth = 1
@@ -184,8 +207,11 @@ def outcome(comm=MPI.COMM_WORLD):
     agree.Free()
     failed = [o for o in outcomes if o is not None]
     if not failed:
+        _CREATED.clear()
         return
     rank, code, kind, text = failed[0]
+    _tidy(failure if failure is not None and rank == comm.rank else
+          (InputError_() if code == 2 else None), comm.rank)
     alone = rank if len(failed) < comm.size else None
     if comm.rank == 0:
         exc = failure if failure is not None else RankFailure(text, code, kind)
@@ -195,6 +221,11 @@ def outcome(comm=MPI.COMM_WORLD):
         raise failure
     raise RankFailure(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,
                       kind) from failure
+
+
+def InputError_():
+    from damage_dolfinx.parameters import InputError
+    return InputError("")
 
 
 class _Local:
