@@ -317,11 +317,28 @@ def _check_finite(args):
 def main(argv=None):
     """The command; every rank returns the same exit status (runtime/collective.py: an
     exception on one rank only becomes one decided outcome, or ends the job)."""
+    import signal
+    from damage_dolfinx.runtime.signals import stop_outside_runs
     comm = MPI.COMM_WORLD
+    given = {}
+    before = {}
+    try:
+        for s in (signal.SIGTERM, signal.SIGINT):  # the run's loop has its own (StopSignals)
+            before[s] = signal.signal(s, stop_outside_runs)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        return _main(argv, comm, given)
+    finally:
+        for s, handler in before.items():
+            if signal.getsignal(s) is stop_outside_runs:  # (an interruption leaves SIG_IGN)
+                signal.signal(s, handler)
+
+
+def _main(argv, comm, given):
     from damage_dolfinx.runtime import collective
     from damage_dolfinx.runtime.io import OutputError
     from damage_dolfinx.runtime.signals import RunInterrupted
-    given = {}
     try:
         with collective.outcome(comm):
             try:
@@ -361,6 +378,9 @@ def _command(argv, comm, given):
     given.update(_petsc_options(extra, parser, args.command))
     _check_finite(args)
     _check_petsc_values(given)
+    if args.command != "list":
+        from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
+        import_gmsh_keeping_sigint()
     if args.command == "list":
         from damage_dolfinx.catalogue import examples
         if comm.rank == 0:

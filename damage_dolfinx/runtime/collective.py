@@ -59,10 +59,13 @@ def classify(exc) -> tuple:
     if isinstance(exc, RunInterrupted):
         return exc.exit_status, "", "interrupted"
     if isinstance(exc, KeyboardInterrupt):
-        return 130, "", "interrupted"
+        return getattr(exc, "exit_status", 130), "", "interrupted"
     if isinstance(exc, SystemExit):
         code = exc.code if isinstance(exc.code, int) else 1
         return code, "", "failed"
+    from damage_dolfinx.runtime.signals import RECEIVED
+    if RECEIVED["signum"]:  # whatever broke after a stop signal broke because of it
+        return 128 + RECEIVED["signum"], "", "interrupted"
     from damage_dolfinx.numerics.solvers import ConvergenceError
     if isinstance(exc, ConvergenceError):
         return 3, "solver failure", "failed"
@@ -79,8 +82,13 @@ def describe(exc) -> str:
     from damage_dolfinx.runtime.atomic import OutputError
     from damage_dolfinx.runtime.signals import RunInterrupted
     from damage_dolfinx.numerics.solvers import ConvergenceError
-    if isinstance(exc, KeyboardInterrupt):
-        return "stopped by SIGINT before the run's first step (nothing to restart)"
+    from damage_dolfinx.runtime.signals import RECEIVED
+    if isinstance(exc, KeyboardInterrupt) or (RECEIVED["signum"] and not isinstance(
+            exc, RunInterrupted)):
+        import signal
+        name = signal.Signals(RECEIVED["signum"] or signal.SIGINT).name
+        return f"stopped by {name} before the end (no checkpoint of this stage: a rerun " \
+               "starts it again)"
     text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
     if isinstance(exc, (InputError, OutputError, RunInterrupted, ConvergenceError, RankFailure)):
         return text or type(exc).__name__
@@ -137,7 +145,7 @@ def track(folder, kind="run"):
     _FOLDERS.append((Path(folder), kind))
 
 
-def mark(folder, exc, rank=None):
+def mark(folder, exc, rank=None, kind=None):
     """Record a failure in ``folder``/summary.json if the run there has not recorded an outcome
     itself (status 'running' or no summary); only a folder the package claimed (listed in a
     manifest) is written into."""
@@ -154,6 +162,10 @@ def mark(folder, exc, rank=None):
     if summary.get("status") not in (None, "running"):
         return
     _, _, status = classify(exc)
+    schema = {"run": "damage-dolfinx/summary/v1", "study": "damage-dolfinx/convergence/v1",
+              "sweep": "damage-dolfinx/sweep/v1"}.get(kind)
+    if schema and "schema" not in summary:
+        summary["schema"] = schema
     summary.update(status="failed" if status == "refused" else status, error=describe(exc))
     if rank is not None:
         summary["failed_rank"] = rank
@@ -167,15 +179,18 @@ def mark(folder, exc, rank=None):
 @contextlib.contextmanager
 def outcome(comm=MPI.COMM_WORLD):
     """Run the body; on every rank the same outcome (see the module's docstring)."""
-    if comm.size == 1 or getattr(_LOCAL, "depth", 0):
+    if not _LOCAL.depth:  # a new call: no signal yet
+        from damage_dolfinx.runtime.signals import RECEIVED
+        RECEIVED["signum"] = 0
+    if comm.size == 1 or _LOCAL.depth:
         _LOCAL.depth = getattr(_LOCAL, "depth", 0) + 1
         start = len(_FOLDERS)
         try:
             yield
         except BaseException as exc:
             if comm.size == 1 and _LOCAL.depth == 1:
-                for folder, _ in _FOLDERS[start:]:
-                    mark(folder, exc)
+                for folder, kind in _FOLDERS[start:]:
+                    mark(folder, exc, kind=kind)
                 _tidy(exc, 0)
             raise
         finally:
@@ -215,8 +230,8 @@ def outcome(comm=MPI.COMM_WORLD):
     alone = rank if len(failed) < comm.size else None
     if comm.rank == 0:
         exc = failure if failure is not None else RankFailure(text, code, kind)
-        for folder, _ in folders:
-            mark(folder, exc, alone)
+        for folder, where in folders:
+            mark(folder, exc, alone, where)
     if failure is not None and rank == comm.rank:
         raise failure
     raise RankFailure(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,
@@ -237,8 +252,8 @@ _LOCAL = _Local()
 
 def _abort(comm, exc, folders):
     """The others are blocked: status, the one line, and the job ended with the exit status."""
-    for folder, _ in folders:
-        mark(folder, exc, comm.rank)
+    for folder, where in folders:
+        mark(folder, exc, comm.rank, where)
     code = classify(exc)[0]
     try:
         print(line(exc, comm.rank) + "; the other ranks were waiting: job aborted",
