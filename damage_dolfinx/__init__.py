@@ -22,7 +22,7 @@ __all__ = ["Problem", "MODELS", "model_defaults", "run", "converge", "sweep", "g
            "InputError"]
 
 _WHERE = {"Problem": "problem", "run": "workflow", "converge": "workflow",
-          "sweep": "studies.sweep", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
+          "sweep": "workflow", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
           "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
           "ModelParameters": "parameters", "InputError": "parameters"}
 

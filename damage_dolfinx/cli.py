@@ -381,8 +381,8 @@ def _command(argv, comm, given):
     if args.command != "list":
         from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
         import_gmsh_keeping_sigint()
+    from damage_dolfinx.catalogue import examples  # the catalogue's ids (runtime/cases.py)
     if args.command == "list":
-        from damage_dolfinx.catalogue import examples
         if comm.rank == 0:
             for ex in examples.catalogue().values():
                 reading = f" (reading: {ex.reading})" if ex.readings else ""

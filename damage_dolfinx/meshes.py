@@ -120,13 +120,17 @@ def tag_counts(geometry: Geometry) -> dict:
     return out
 
 
-def retag(geometry: Geometry, boundaries, required=None, model_id=None) -> Geometry:
+#: the contact roles a boundary part may play (a model declares which of them it takes)
+CONTACT_ROLES = ("bilateral", "tresca", "coulomb", "normal_compliance")
+
+
+def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry:
     """The geometry with its facet tags renamed to the roles the models read (1 clamped,
     2 traction, 3 contact), from ``boundaries`` = {role: tag or tags}; None keeps the tags as
-    they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty."""
+    they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty.
+    ``model``: the model class, whose ``contact_roles`` are the contact roles allowed."""
     from damage_dolfinx import compat
-    from damage_dolfinx.models.registry import (CLAMPED, CONTACT, CONTACT_ROLES, MODELS,
-                                                TRACTION)
+    from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION
     counts = tag_counts(geometry)
     where = geometry.description or "the mesh"
     for what, tag in (required or {}).items():
@@ -134,12 +138,12 @@ def retag(geometry: Geometry, boundaries, required=None, model_id=None) -> Geome
             raise InputError(f"{where}: the {what} tag {tag} is missing or empty")
     if boundaries is None:
         return geometry
-    allowed = ("clamped", "traction") + (MODELS[model_id].contact if model_id else CONTACT_ROLES)
+    allowed = ("clamped", "traction") + (model.contact_roles if model else CONTACT_ROLES)
     internal = {"clamped": CLAMPED, "traction": TRACTION}
     mapping = {}
     for role, tags in boundaries.items():
         if role not in allowed:
-            raise InputError(f"boundary role {role!r} is not one of model {model_id}'s: "
+            raise InputError(f"boundary role {role!r} is not one of model {model.id}'s: "
                              f"{', '.join(allowed)}")
         for tag in ([tags] if isinstance(tags, (int, np.integer)) else list(tags)):
             if not counts.get(int(tag)):

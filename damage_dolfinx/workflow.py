@@ -5,6 +5,14 @@ from __future__ import annotations
 from mpi4py import MPI
 
 
+def _named(problem):
+    """A catalogue id needs the catalogue loaded (it registers its ids with the run machinery,
+    which does not import it)."""
+    if isinstance(problem, str):
+        import damage_dolfinx.catalogue  # noqa: F401
+    return problem
+
+
 def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
         checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
@@ -30,7 +38,7 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
                                                                  "overwrite"))
         checkpoint_every, progress, figures = (checked[key] for key in (
             "checkpoint_every", "progress", "figures"))
-        return _run(problem, out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+        return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
                     checkpoint_every=checkpoint_every, progress=progress, figures=figures,
                     comm=comm)
 
@@ -48,7 +56,7 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     from damage_dolfinx.validation import check_converge
     with outcome(comm):
         n, k, ref_n, ref_k, T = check_converge(n, k, ref_n, ref_k, T)
-        return study(problem, out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
+        return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
                      progress=progress, comm=comm)
 
 
@@ -58,3 +66,16 @@ def gather(function):
     parallel one compare entry by entry; ``None`` on the other ranks (collective)."""
     from damage_dolfinx.runtime.io import gather_dof_field
     return gather_dof_field(function)
+
+
+def sweep(problem, out, grid, **kwargs) -> dict:
+    from damage_dolfinx.studies.sweep import sweep as _sweep
+    return _sweep(_named(problem), out, grid, **kwargs)
+
+
+def _sweep_doc():
+    from damage_dolfinx.studies.sweep import sweep as _sweep  # light: no DOLFINx import
+    return _sweep.__doc__
+
+
+sweep.__doc__ = _sweep_doc()

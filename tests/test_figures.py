@@ -92,7 +92,7 @@ def test_fidelity_reads_the_tables_and_our_studies(tmp_path):
 
 @pytest.mark.parametrize("name", ["figure_2_24_25.png", "figure_3_17_18.png"])
 def test_one_file_per_thesis_figure(name):
-    from damage_dolfinx.report import reproduce
+    from reproduction import reproduce
     variants = {"figure_2_24_25.png": ("2.4-ex1", "tresca", "coulomb"),
                 "figure_3_17_18.png": ("3.3-ex2", "a", "b")}[name]
     ex, *vs = variants

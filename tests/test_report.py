@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from damage_dolfinx.report import build as report, reproduce
+from reproduction import build as report, reproduce
 
 CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 
@@ -57,7 +57,7 @@ def test_quick_figures_and_report(tmp_path):
 def _self_contained(folder, tmp_path):
     """The report folder stands alone: no machine path, tracker history or internal code, every
     image inside it; it still displays after a move. The check fails on a planted path."""
-    from damage_dolfinx.report.text import self_contained_problems
+    from reproduction.text import self_contained_problems
     assert self_contained_problems(folder) == []
     moved = tmp_path / "elsewhere" / "copy"
     shutil.copytree(folder, moved)
@@ -125,7 +125,7 @@ def test_resumed_reproduction_keeps_completed_runs(tmp_path):
 def test_markdown_norm_at_line_start_is_text_not_a_table():
     """benchmarks/readings.md wraps lines that begin with a norm ('||eps(u)||_L2 = ...'): a
     pipe table needs its delimiter row, as in GitHub Markdown."""
-    from damage_dolfinx.report import doc as report_doc
+    from reproduction import doc as report_doc
     html = report_doc._markdown_to_html("a reading,\n||eps(u)||_L2 = 1e-3, so\n\n| n | k |\n"
                                         "|---|--:|\n| 4 | 0.1 |\n")
     assert html.count("<table>") == 1 and "<p>a reading, ||eps(u)||_L2 = 1e-3, so</p>" in html
@@ -137,9 +137,9 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
     fitted reading 'reproduced under a reading' with the departure named."""
     import numpy as np
     from damage_dolfinx.viz import figstyle
-    from damage_dolfinx.report.checks import departure, judge
-    from damage_dolfinx.report.figures import ThesisFigure
-    from damage_dolfinx.report.verdicts import CLASSES, category
+    from reproduction.checks import departure, judge
+    from reproduction.figures import ThesisFigure
+    from reproduction.verdicts import CLASSES, category
     xs = np.linspace(0.0, 1.0, 9)
     cells = np.array([[(xs[i], xs[j]), (xs[i + 1], xs[j]), (xs[i + 1], xs[j + 1])]
                       for i in range(8) for j in range(8)])
@@ -174,7 +174,7 @@ def test_verdict_classes_on_synthetic_figures(tmp_path):
 def test_reader_text_and_units():
     """Thesis line numbers become sections and pages, codes their meaning; stresses in MPa."""
     from damage_dolfinx.viz import figstyle
-    from damage_dolfinx.report.text import assumption, forbidden, reader_text
+    from reproduction.text import assumption, forbidden, reader_text
     assert reader_text("(thesis line 3973)") == "(thesis §3.2.3, p. 176)"
     assert assumption("G6: kappa = 1e-2 (missing in the thesis)") == \
         "assumed: kappa = 1e-2 (missing in the thesis)"

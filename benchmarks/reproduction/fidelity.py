@@ -32,9 +32,12 @@ import json
 import math
 import re
 import statistics
+import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+from common import REPO  # noqa: E402
+
 LOCAL_TABLES = REPO / "benchmarks" / "thesis_tables.json"
 REFERENCE = REPO / "benchmarks" / "reference_output" / "convergence"
 LITERAL = REPO / "benchmarks" / "reference_output" / "convergence-literal"

@@ -5,7 +5,7 @@
 Runs every catalogue example (and its variants) with `damage-dolfinx run` under
 `mpirun -n NP`, copies the figures into OUT and writes OUT/index.json (command, status and wall
 time of each run). Quick mode: coarse meshes at the thesis time steps; full mode: thesis
-resolutions. See damage_dolfinx/reproduce.py.
+resolutions. See reproduction/reproduce.py.
 
 Thesis pairs drawn by different runs or at different times (2.4/2.5, 2.17, 2.20, 2.24/2.25,
 3.8) are then re-rendered from their saved panel data on one stress scale (figstyle.render_pair).
@@ -14,8 +14,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from damage_dolfinx.viz import figstyle
-from damage_dolfinx.report import reproduce
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+import common  # noqa: E402,F401  (puts the checkout on sys.path)
+from damage_dolfinx.viz import figstyle  # noqa: E402
+from reproduction import reproduce  # noqa: E402
 
 #: thesis figures whose two files share one stress (or strain) colour scale
 PAIRS = [("figure_2_4.png", "figure_2_5.png"), ("figure_2_17_t0.png", "figure_2_17_t2.png"),

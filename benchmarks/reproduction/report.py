@@ -14,9 +14,13 @@ import argparse
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
+from pathlib import Path
 
-from damage_dolfinx.report import build as report
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+import common  # noqa: E402,F401  (puts the checkout on sys.path)
+from reproduction import build as report  # noqa: E402
 
 p = argparse.ArgumentParser()
 p.add_argument("--results", default="results")

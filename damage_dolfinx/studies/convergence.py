@@ -26,7 +26,6 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx.catalogue import examples
 from damage_dolfinx.runtime import io
 from damage_dolfinx.viz import post
 from damage_dolfinx.parameters import InputError, TimeGrid

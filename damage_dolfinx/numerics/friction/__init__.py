@@ -60,6 +60,19 @@ __all__ = ["law", "AlgebraicResidual", "ConstantOperator", "ContactNodes", "FAST
 
 SOLVERS = ("newton", "uzawa", "penalty-duality")
 
+#: Uzawa step (the thesis gives none) from log-spaced sweeps: at n = 16, k = 0.01 (all nodes slip)
+#: rho = 1, 10, 100 give 2 iterations per step (Newton solution to 2e-14), rho = 0.01 needs 25; at
+#: k = 0.02 (stick-slip) rho = 10 oscillates (no convergence), rho = 1 needs 17-31 and rho = 0.1
+#: 87-135 per step
+RHO_UZAWA = 1.0
+#: Bermudez-Moreno omega from the same sweep: omega = 100, 300, 1000 give 50, 31, 86 iterations
+#: per step and 4.6e-7, 2.5e-6, 1.0e-5 relative V-distance to Newton at tol 1e-6
+OMEGA_PD = 100.0
+
+#: the friction data every friction model's defaults hold (``params.extra``)
+FRICTION_DEFAULTS = {"eps_reg": 1e-9, "friction_solver": "newton", "rho_uzawa": RHO_UZAWA,
+                     "omega_pd": OMEGA_PD, "friction_tol": 1e-6}
+
 
 def iteration_counters(solver) -> dict:
     """The friction solver's fallback counters for summary.json (zeros for Uzawa and PD)."""

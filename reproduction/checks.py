@@ -2,7 +2,7 @@
 
 A figure's data are the ``.panel.npz`` post.plot_fields saves beside it (undeformed and deformed
 vertex coordinates, stress and damage per vertex) and its run's ``history.csv`` and
-``summary.json``. Each check of report_figures.THESIS_FIGURES tests the quantity the quoted
+``summary.json``. Each check of reproduction.figures.THESIS_FIGURES tests the quantity the quoted
 thesis sentence is about; :func:`judge` grades the figure (report_verdicts.CLASSES):
 
 * *not visible in this figure* when the statement is about the damage and the damage is one

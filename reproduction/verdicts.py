@@ -20,7 +20,7 @@ from __future__ import annotations
 import html
 import re
 
-from damage_dolfinx.report.doc import _inline
+from reproduction.doc import _inline
 
 CLASSES = ("reproduced", "reproduced under a reading", "setting assumed",
            "not visible in this figure", "differs", "not comparable")
@@ -43,7 +43,7 @@ def headline(counts: dict) -> str:
 
 def table_verdict(t: dict) -> str:
     """A thesis error table beside our study (benchmarks/reproduction/fidelity.py's comparison)."""
-    from damage_dolfinx.report.checks import departure
+    from reproduction.checks import departure
     v = t.get("verdict", "not comparable")
     if v.startswith("not comparable"):
         return v

@@ -21,13 +21,13 @@ import shutil
 import time
 from pathlib import Path
 
-from damage_dolfinx.report.doc import Doc, _inline
-from damage_dolfinx.report.records import (REPO, _bridge, _friction_cpu, _performance, _shown, _status,
+from reproduction.doc import Doc, _inline
+from reproduction.records import (REPO, _bridge, _friction_cpu, _performance, _shown, _status,
                              _step_floor, _threed_scaling, _wall_times)
-from damage_dolfinx.report.sources import (Figures, _bridge_summary, _convergence_png, _fidelity, _load_json,
+from reproduction.sources import (Figures, _bridge_summary, _convergence_png, _fidelity, _load_json,
                              _study_folder)
-from damage_dolfinx.report.text import assumption, example_ref
-from damage_dolfinx.report.verdicts import (CLASSES, category, headline, known_differences, summary_table,
+from reproduction.text import assumption, example_ref
+from reproduction.verdicts import (CLASSES, category, headline, known_differences, summary_table,
                               table_rows)
 
 SECTION_TITLES = {
@@ -82,9 +82,9 @@ def build(results: Path) -> Path:
     """Write ``<results>/report/`` (REPORT.html with its images, REPORT.md); returns the HTML
     path."""
     from damage_dolfinx.catalogue import examples
-    from damage_dolfinx.report import reproduce
-    from damage_dolfinx.report.checks import judge, run_context
-    from damage_dolfinx.report.figures import THESIS_FIGURES
+    from reproduction import reproduce
+    from reproduction.checks import judge, run_context
+    from reproduction.figures import THESIS_FIGURES
     results = Path(results).resolve()
     folder = results / FOLDER
     if folder.exists():

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from damage_dolfinx.viz import figstyle
+from reproduction import CHECKOUT
 from damage_dolfinx.runtime.atomic import strict_json
 
 #: variants of an example that the thesis draws separately: suffix -> parameter overrides
@@ -277,7 +278,7 @@ def _figure_run(job, ranks, runs, out, resume) -> tuple:
 
 def _bridge_force_displacement(mode, out, np_, index):
     """Figure 2.7 (force-displacement curve of the arch) from benchmarks/studies/bridge_collapse.py."""
-    script = Path(__file__).resolve().parents[2] / "benchmarks" / "studies" / "bridge_collapse.py"
+    script = CHECKOUT / "benchmarks" / "studies" / "bridge_collapse.py"
     if not script.is_file():
         return
     folder = out / "runs" / "bridge_collapse"
