@@ -116,14 +116,15 @@ def check_problem(problem):
     """The problem with its scalars normalised (NumPy scalars to Python), or InputError.
     Called where the Problem is turned into a run (``Problem.example``)."""
     from damage_dolfinx.laws import DamageLaw
-    from damage_dolfinx.models.registry import MODELS
+    from damage_dolfinx.models.registry import MODELS, model as model_class
     from damage_dolfinx.parameters import ModelParameters
     model = problem.model
     if isinstance(model, np.str_):
         model = str(model)
-    if not isinstance(model, str) or model not in MODELS:
-        raise InputError(f"model must be one of {', '.join(MODELS)}, got {_shown(model)}")
-    info = MODELS[model]
+    if not isinstance(model, (str, type)):
+        raise InputError(f"model must be a model id ({', '.join(MODELS)}) or a model class, "
+                         f"got {_shown(model)}")
+    info = model_class(model)  # InputError for an unknown id
     T = positive("T (final time)", problem.T)
     k = positive("k (time step)", problem.k, allow_none=True)
     if k is not None and k > T * (1 + 1e-12):
@@ -135,9 +136,9 @@ def check_problem(problem):
     params = problem.params
     if params is not None and not isinstance(params, (dict, ModelParameters)):
         raise InputError(f"params must be a dict of changes or a ModelParameters "
-                         f"(model_defaults({model!r})), got {type(params).__name__}")
+                         f"(model_defaults({info.id!r})), got {type(params).__name__}")
     if isinstance(params, ModelParameters):
-        _check_parameters_of(params, model)
+        _check_parameters_of(params, info)
     elif isinstance(params, dict):
         params = {_key("params", key): _param_value(key, value) for key, value in params.items()}
     for name in ("traction", "body_force"):
@@ -209,7 +210,7 @@ def _check_boundaries(boundaries, info):
     if not isinstance(boundaries, dict) or not boundaries:
         raise InputError("boundaries must be a dict {role: tag or [tags]}, got "
                          f"{_shown(boundaries)}")
-    allowed = ("clamped", "traction") + tuple(info.contact)
+    allowed = ("clamped", "traction") + tuple(info.contact_roles)
     for role, tags in boundaries.items():
         if role not in allowed:
             raise InputError(f"boundaries: role {role!r} is not one of model {info.id}'s: "
@@ -247,15 +248,14 @@ def _param_value(key, value):
                      f"{_shown(value)} ({type(value).__name__})")
 
 
-def _check_parameters_of(params, model):
+def _check_parameters_of(params, info):
     """A ModelParameters built for another model (model_defaults('3.3') given to a 2.2
     problem) lacks this model's data."""
-    from damage_dolfinx.models.registry import default_parameters
-    own = default_parameters(model)
+    own = info.defaults()
     missing = sorted(set(own.extra) - set(params.extra))
     if missing:
-        raise InputError(f"params: a ModelParameters without model {model}'s data "
-                         f"({', '.join(missing)}); start from model_defaults({model!r})")
+        raise InputError(f"params: a ModelParameters without model {info.id}'s data "
+                         f"({', '.join(missing)}); start from model_defaults({info.id!r})")
 
 
 # ---------------------------------------------------------------------------- with the mesh
