@@ -249,10 +249,10 @@ def fingerprint(ex, stepper) -> dict:
     comm = msh.comm
     tdim, gdim = msh.topology.dim, msh.geometry.dim
     x_local = msh.geometry.x[:, :gdim]
-    lo = comm.allreduce(x_local.min(axis=0) if len(x_local) else np.full(gdim, np.inf),
-                        op=MPI.MIN)
-    hi = comm.allreduce(x_local.max(axis=0) if len(x_local) else np.full(gdim, -np.inf),
-                        op=MPI.MAX)
+    lo = np.array(x_local.min(axis=0) if len(x_local) else np.full(gdim, np.inf), dtype=float)
+    hi = np.array(x_local.max(axis=0) if len(x_local) else np.full(gdim, -np.inf), dtype=float)
+    comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
     out = {"mesh": f"{msh.topology.index_map(tdim).size_global} cells, "
                    f"{msh.topology.index_map(0).size_global} vertices, box "
                    f"{np.round(lo, 9).tolist()}-{np.round(hi, 9).tolist()}, tags "
