@@ -45,10 +45,18 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     * :class:`~damage_dolfinx.RunInterrupted`: SIGTERM, SIGINT or SIGUSR1 stopped the run at the
       end of a step after a checkpoint (summary.json "interrupted"; ``restart=True`` goes on).
     """
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.runner import run as _run
-    return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
-                checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                comm=comm, on_step=on_step)
+    from damage_dolfinx.validation import check_run
+    with outcome(comm):
+        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out)
+        n, k, T, restart, overwrite = (checked[key] for key in ("n", "k", "T", "restart",
+                                                                 "overwrite"))
+        checkpoint_every, progress, figures = (checked[key] for key in (
+            "checkpoint_every", "progress", "figures"))
+        return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                    checkpoint_every=checkpoint_every, progress=progress, figures=figures,
+                    comm=comm, on_step=on_step)
 
 
 def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
@@ -81,9 +89,13 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     mesh`` of nested structured meshes (:func:`damage_dolfinx.geometries.rectangle.rectangle`):
     coarse solutions are transferred to the reference mesh exactly. Every n must divide
     ``ref_n`` and every k must be a multiple of ``ref_k``."""
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=list(n), ks=list(k), T=T,
-                 progress=progress, comm=comm)
+    from damage_dolfinx.validation import check_converge
+    with outcome(comm):
+        n, k, ref_n, ref_k, T = check_converge(n, k, ref_n, ref_k, T)
+        return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
+                     progress=progress, comm=comm)
 
 
 def gather(function):
