@@ -301,10 +301,7 @@ class Model:
                  compat.form(ufl.inner(eps(du), eps(w)) * ufl.dx)]
         mats = []
         for a in forms:
-            A = compat.create_matrix(a)
-            compat.assemble_matrix(A, a, [])
-            A.assemble()
-            mats.append(bookkeeping.block_operator(A))
+            mats.append(bookkeeping.norm_matrix(a, V.dofmap.index_map_bs))
         m_form = compat.form(ufl.TestFunction(Z) * ufl.dx)
         m = compat.create_vector(m_form)
         with m.localForm() as ml:
