@@ -35,12 +35,14 @@ from mpi4py import MPI
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.parameters import ModelParameters
 
 
 #: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
@@ -50,10 +52,24 @@ from damage_dolfinx.models.base import ProblemData, TimeStepper
 VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
 
 
-class DynamicKelvinVoigt(TimeStepper):
+class DynamicKelvinVoigt(Model):
     """Problem VP^{hk} of Section 3.1."""
 
-    extra_history_columns = ["v_L2", "u_max", "penetration_rms"]
+    id = "3.1"
+    title = "dynamic Kelvin-Voigt body, normal compliance"
+    contact_roles = ("normal_compliance",)
+    dynamic = True
+    stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
+    checkpoint_fields = ("u", "zeta", "v")
+    history_columns = ("v_L2", "u_max", "penetration_rms")
+    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # damage, (3.48)
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, q_star=1.0),
+                               extra={"rho": 1.0, "m_visc": 10.0, "c_nu": 1e4, "gap": 0.0,
+                                      "damage_active": True, "stability_check": "error",
+                                      "error_norm": "velocity"})
 
     def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
@@ -114,11 +130,6 @@ class DynamicKelvinVoigt(TimeStepper):
         self.timings = {"damage": 0.0, "velocity": 0.0, "stability": self.stability.get("time_s", 0.0)}
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)  # u_0 = v_0 = 0
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}
-
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array
         self.v_old.x.array[:] = self.v.x.array
@@ -139,13 +150,13 @@ class DynamicKelvinVoigt(TimeStepper):
         action = x.get("stability_check", "warn")
         if action == "off":
             return {}
-        from damage_dolfinx.numerics.stability import check_time_step, estimate_stability
+        from damage_dolfinx.numerics.stability import checked, estimate_stability
         start = time.perf_counter()
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
-                                 bcs=self.bcs, normal=self.n_facet)
+                                 bcs=self.bcs, normal=self.n_facet, k=self.k)
         where = f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate"
-        out["k_over_k_max"] = check_time_step(self.k, out["k_max"], where, action=action)
+        checked(out, self.k, where, action)
         out["time_s"] = time.perf_counter() - start
         return out
 
@@ -164,9 +175,8 @@ class DynamicKelvinVoigt(TimeStepper):
     def u_max(self) -> float:
         """max over the nodes of |u_n| (the L-shape comparison of Example 3)."""
         owned = self.u.function_space.dofmap.index_map.size_local
-        u = self.u.x.array.reshape(-1, self.mesh.topology.dim)[:owned]
-        return self.comm.allreduce(float(np.linalg.norm(u, axis=1).max()) if owned else 0.0,
-                                   op=MPI.MAX)
+        d = self.mesh.topology.dim
+        return bookkeeping.max_node_norm(self.u.x.array[:owned * d], d, self.comm)
 
     def scalars(self) -> dict:
         out = super().scalars()
@@ -179,6 +189,11 @@ class DynamicKelvinVoigt(TimeStepper):
         pen = compat.assemble_scalar(self._penetration, self.comm) if length > 0 else 0.0
         out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
         return out
+
+    def contact_pressure(self):
+        """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
+        from damage_dolfinx.numerics.contact import normal_compliance_pressure
+        return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations if self.damage else 0,

@@ -32,17 +32,34 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
-from damage_dolfinx.numerics.stability import check_time_step, estimate_k_max
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.numerics.stability import checked, estimate_stability
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.parameters import ModelParameters
 
 
-class DynamicTresca(TimeStepper):
+class DynamicTresca(Model):
     """Problem VP^{hk} of Section 3.2.
 
     Builders (ProblemData.builders): ``friction_bound`` (x -> UFL g(x), default the constant
     ``g_fric``) and ``contact_faces`` ({name: marker x -> bool}): for each face the history gets
     ``u_tau_max_<name>``, the largest |u_tau| over its contact nodes (nodal values).
     """
+
+    id = "3.2"
+    title = "dynamic Kelvin-Voigt body, bilateral contact with Tresca friction"
+    contact_roles = ("tresca",)
+    dynamic = True
+    stability_limit = "explicit elastic force (eigenvalue estimate)"
+    checkpoint_fields = ("u", "zeta", "v")
+    history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face
+    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, lam_D=0.0),
+                               extra={"rho": 1.0, "m_visc": 100.0, "g_fric": 5.0,
+                                      "stability_check": "error", **FRICTION_DEFAULTS})
 
     def __init__(self, data: ProblemData):
         super().__init__(data)
@@ -90,11 +107,6 @@ class DynamicTresca(TimeStepper):
         self.timings = {"damage": 0.0, "friction": 0.0}
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)  # u_0 = v_0 = 0
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}
-
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array
         self.v_old.x.array[:] = self.v.x.array
@@ -120,11 +132,12 @@ class DynamicTresca(TimeStepper):
         if action == "off":
             return None
         p = self.params  # Tresca adds no explicit stiffness: c_nu = 0; eta_* Phi_L only lowers B
-        k_max = estimate_k_max(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
-                               bcs=self.bcs)
+        out = estimate_stability(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
+                                 bcs=self.bcs, k=self.k)
         where = f"{self.data.example_id}: explicit elastic force, eigenvalue estimate"
-        check_time_step(self.k, k_max, where, action=action)
-        return float(k_max)
+        checked(out, self.k, where, action)
+        self.k_max_lower_bound = out.get("k_max_lower_bound")
+        return None if out["k_max"] is None else float(out["k_max"])
 
     # -- measured tangential displacement on named contact faces (Example 2: top vs bottom)
     def _faces_setup(self, faces: dict):
@@ -149,4 +162,7 @@ class DynamicTresca(TimeStepper):
                 "friction_solver": self.friction.name, **iteration_counters(self.friction)}
 
     def summary_extra(self) -> dict:
-        return {} if self.k_max is None else {"k_max": self.k_max}
+        out = {} if self.k_max is None else {"k_max": self.k_max}
+        if getattr(self, "k_max_lower_bound", None) is not None:
+            out["k_max_lower_bound"] = self.k_max_lower_bound  # no eigensolve: k below it
+        return out

@@ -40,6 +40,57 @@ STRESS_CMAP = "inferno"
 DAMAGE_LABEL = "$\\zeta$ (1 = sound,\n$\\zeta^*$ = fully damaged)"
 
 
+# ---------------------------------------------------------------------------- primitives
+# One matplotlib object per layer, never one per cell (a 10^5-cell mesh as 10^5 Path objects
+# takes seconds to build and draw). Edges: every triangle's outline in one Path (interior
+# edges stroked twice, as when each triangle was its own polygon). Fields: Gouraud-shaded
+# triangles in one draw call; a DG0 value is given to its triangle's three corners (the soup
+# has its own vertices per cell), so the triangle has the one colour of its value, as a flat
+# tripcolor polygon would. Large layers are rasterised in vector output.
+#: cells above which a layer is rasterised in vector output
+RASTERISE_CELLS = 3000
+
+
+def triangle_path(xy):
+    """One Path of the outlines of the triangles ``xy`` (nc, 3, 2)."""
+    from matplotlib.path import Path
+    xy = np.asarray(xy, dtype=float)
+    nc = xy.shape[0]
+    verts = np.concatenate([xy, xy[:, :1]], axis=1).reshape(-1, 2)
+    codes = np.tile(np.array([Path.MOVETO, Path.LINETO, Path.LINETO, Path.CLOSEPOLY],
+                             dtype=Path.code_type), nc)
+    return Path(verts, codes)
+
+
+def triangle_edges(ax, xy, colour="k", linewidth=0.35, zorder=2):
+    """The edges of the triangles ``xy`` (nc, 3, 2) as one PathPatch; returns it."""
+    from matplotlib.patches import PathPatch
+    patch = PathPatch(triangle_path(xy), facecolor="none", edgecolor=colour,
+                      linewidth=linewidth, zorder=zorder, joinstyle="miter", capstyle="butt")
+    patch.set_rasterized(len(xy) > RASTERISE_CELLS)
+    ax.add_artist(patch)  # add_patch would walk the 10^5 segments for the data limits
+    ax.update_datalim(np.asarray(xy, dtype=float).reshape(-1, 2))
+    return patch
+
+
+def draw_field(ax, tri, values, cmap, vmin, vmax):
+    """The field ``values`` (nc, 3) P1 or (nc,) DG0 on the soup triangulation ``tri`` (three
+    vertices of its own per cell) as one Gouraud-shaded collection; returns the mappable."""
+    values = np.asarray(values, dtype=float)
+    per_vertex = values.reshape(-1) if values.ndim == 2 else np.repeat(values, 3)
+    from matplotlib.collections import TriMesh
+    # what ax.tripcolor(shading="gouraud") does, without its add_collection(autolim=True), which
+    # converts the mesh to one Path per triangle only to find the data limits
+    im = TriMesh(tri, array=per_vertex, cmap=cmap)
+    im.set_clim(vmin, vmax)
+    im.set_rasterized(len(per_vertex) // 3 > RASTERISE_CELLS)
+    ax.grid(False)
+    ax.update_datalim([(tri.x.min(), tri.y.min()), (tri.x.max(), tri.y.max())])
+    ax.autoscale_view()
+    ax.add_collection(im, autolim=False)
+    return im
+
+
 # ---------------------------------------------------------------------------- drawing
 def plt():
     import matplotlib
@@ -99,10 +150,8 @@ def draw_outline(ax, ref_xy, label="undeformed outline"):
 
 
 def draw_mesh_edges(ax, xy, lw=None):
-    from matplotlib.collections import PolyCollection
     lw = lw or (0.35 if len(xy) < 3000 else 0.2)
-    ax.add_collection(PolyCollection(xy, facecolors="none", edgecolors="k", linewidths=lw,
-                                     zorder=2))
+    triangle_edges(ax, xy, colour="k", linewidth=lw, zorder=2)
 
 
 def _triangulation(xy):
@@ -215,11 +264,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
             else:
                 vmin, vmax = (limits or {}).get(i) or (0.0, float(np.nanmax(vals)) or 1.0)
                 cmap, label, note = STRESS_CMAP, mathtext(p.get("label", "")), ""
-            if vals.ndim == 2:
-                im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap=cmap,
-                                  vmin=vmin, vmax=vmax)
-            else:
-                im = ax.tripcolor(tri, facecolors=vals, cmap=cmap, vmin=vmin, vmax=vmax)
+            im = draw_field(ax, tri, vals, cmap, vmin, vmax)
             ticks = damage_ticks(vmin, vmax, zeta_star) if damage and zeta_star is not None else None
             label, scale = si_unit(label, vmax) if not damage else (label, 1.0)
             cb = colorbar(fig, ax, im, label, ticks)
@@ -261,11 +306,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
 
 def _stretched_damage(fig, ax, tri, vals, lo, hi):
     """The same damage field on a colour scale stretched to its own range [lo, hi]."""
-    if vals.ndim == 2:
-        im = ax.tripcolor(tri, vals.reshape(-1), shading="gouraud", cmap=STRETCHED_CMAP,
-                          vmin=lo, vmax=hi)
-    else:
-        im = ax.tripcolor(tri, facecolors=vals, cmap=STRETCHED_CMAP, vmin=lo, vmax=hi)
+    im = draw_field(ax, tri, vals, STRETCHED_CMAP, lo, hi)
     cb = colorbar(fig, ax, im, "$\\zeta$ (scale: range of the field)")
     from matplotlib.ticker import FuncFormatter, MaxNLocator
     digits = range_decimals(lo, hi)
@@ -411,10 +452,10 @@ def draw_setting(ax, cells, parts, loads=(), note="", split=None):
     ("f_B", points, vectors, label)); frames the axes on body, markers and arrows; ``note``
     (e.g. why a load is not drawn) goes under the legend. Outline edges no part covers are
     drawn as traction-free; ``split`` divides a part where a quantity changes along it."""
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.collections import LineCollection
     cells = np.asarray(cells)
-    ax.add_collection(PolyCollection(cells, facecolors="none", edgecolors="0.6",
-                                     linewidths=0.3 if len(cells) > 3000 else 0.5))
+    triangle_edges(ax, cells, colour="0.6", zorder=1,
+                              linewidth=0.3 if len(cells) > 3000 else 0.5)
     size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
     inside = inside_test(cells)
     extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
