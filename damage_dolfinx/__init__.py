@@ -13,8 +13,13 @@ The public face (everything else is internal and may change):
   (what a model is built from), :func:`register_model`, :func:`model_class` (a model's class
   by id);
 * :class:`DamageLaw` and the thesis laws :data:`THESIS_A`, :data:`THESIS_B`;
+* :func:`read_run`: a run folder back into a script (summary, history arrays, fields at any
+  stored time);
 * :func:`read_mesh`, :func:`from_gmsh`: meshes from gmsh files or models;
-* :class:`ModelParameters` (material, damage and model data), :class:`InputError`;
+* :class:`ModelParameters` (material, damage and model data);
+* the exceptions :class:`InputError` (bad input, refused before any work),
+  :class:`ConvergenceError` (a solver failed), :class:`OutputError` (an output could not be
+  written), :class:`RunInterrupted` (stopped by a signal, with a checkpoint): damage_dolfinx.errors;
 * the packages :mod:`damage_dolfinx.geometries` (mesh builders) and :mod:`damage_dolfinx.forms`
   (the weak forms in UFL).
 
@@ -25,13 +30,15 @@ __version__ = "0.1.0"
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
            "Model", "SubStep", "ProblemData", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
-           "InputError"]
+           "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run"]
 
 _WHERE = {"Problem": "problem", "run": "workflow", "steps": "workflow", "Model": "models.base",
           "SubStep": "models.base", "ProblemData": "models.base", "converge": "workflow",
           "sweep": "workflow", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
           "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
-          "ModelParameters": "parameters", "InputError": "parameters"}
+          "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results",
+          "ConvergenceError": "numerics.solvers", "OutputError": "runtime.atomic",
+          "RunInterrupted": "runtime.signals"}
 
 
 def __getattr__(name):

@@ -27,16 +27,36 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     larger ``T`` continues a completed run); a folder that already holds a run is refused
     unless ``restart`` or ``overwrite``. SIGTERM/SIGINT stop the run at the end of a step with a
     checkpoint. Under ``mpirun`` every rank calls it; only rank 0 prints. ``n``, ``k``, ``T``
-    override the problem's own. Bad input raises :class:`~damage_dolfinx.InputError` before any
-    work; a solver that fails raises ConvergenceError after marking the summary "failed".
+    override the problem's own. ``fields.xdmf`` is one time series from t = 0 to the last step
+    whatever restarts happened; :func:`~damage_dolfinx.read_run` reads the folder back.
     ``on_step(step)``: called after the initial state and after every step with the
     :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
     the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
+
+    Raises (all importable from ``damage_dolfinx``; damage_dolfinx.errors):
+
+    * :class:`~damage_dolfinx.InputError`: bad input, refused before any work (one line; a
+      folder holding a run without ``restart=True`` or ``overwrite=True``, a k above
+      ``problem.k_max()``, an unknown boundary name, ...);
+    * :class:`~damage_dolfinx.ConvergenceError`: a solver did not converge or a field became
+      NaN/inf or left [zeta*, 1]; summary.json says "failed", the finished steps stay;
+    * :class:`~damage_dolfinx.OutputError`: an output could not be written (full disk, I/O
+      error); summary.json says "failed" where space allows;
+    * :class:`~damage_dolfinx.RunInterrupted`: SIGTERM, SIGINT or SIGUSR1 stopped the run at the
+      end of a step after a checkpoint (summary.json "interrupted"; ``restart=True`` goes on).
     """
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.runner import run as _run
-    return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
-                checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                comm=comm, on_step=on_step)
+    from damage_dolfinx.validation import check_run
+    with outcome(comm):
+        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out)
+        n, k, T, restart, overwrite = (checked[key] for key in ("n", "k", "T", "restart",
+                                                                 "overwrite"))
+        checkpoint_every, progress, figures = (checked[key] for key in (
+            "checkpoint_every", "progress", "figures"))
+        return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                    checkpoint_every=checkpoint_every, progress=progress, figures=figures,
+                    comm=comm, on_step=on_step)
 
 
 def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
@@ -69,9 +89,13 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     mesh`` of nested structured meshes (:func:`damage_dolfinx.geometries.rectangle.rectangle`):
     coarse solutions are transferred to the reference mesh exactly. Every n must divide
     ``ref_n`` and every k must be a multiple of ``ref_k``."""
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=list(n), ks=list(k), T=T,
-                 progress=progress, comm=comm)
+    from damage_dolfinx.validation import check_converge
+    with outcome(comm):
+        n, k, ref_n, ref_k, T = check_converge(n, k, ref_n, ref_k, T)
+        return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
+                     progress=progress, comm=comm)
 
 
 def gather(function):

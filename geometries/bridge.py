@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import gmsh
+from damage_dolfinx.geometries import lazy_gmsh as gmsh
 import numpy as np
 
 from damage_dolfinx import compat

@@ -3,7 +3,7 @@
 Gamma_D = diamond boundary (clamped), Gamma_N = circle (docs/models.md, section 2.1). Mesh size h,
 refined to h_corner near the four diamond corners. The model is meshed on rank 0 and distributed.
 """
-import gmsh
+from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
 from damage_dolfinx import compat
 

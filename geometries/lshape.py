@@ -6,7 +6,7 @@ resting on the obstacle, gap 0), GAMMA_N = [0,2]x{2} (loaded top), FREE = the ot
 ({1}x[0,1], {2}x[1,2], {0}x[0,2], traction free). Unstructured triangles of size h (default
 1/32, i.e. 32 cells per unit length); the model is meshed on rank 0 and distributed.
 """
-import gmsh
+from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError

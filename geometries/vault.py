@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import gmsh
+from damage_dolfinx.geometries import lazy_gmsh as gmsh
 import numpy as np
 
 from damage_dolfinx import compat

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 
-import gmsh
+from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
 from damage_dolfinx import compat
 from damage_dolfinx.parameters import InputError

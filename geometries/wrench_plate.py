@@ -16,7 +16,7 @@ rank 0 (gmsh, tetrahedra) and distributed.
 """
 from __future__ import annotations
 
-import gmsh
+from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
 from damage_dolfinx.parameters import InputError
 

@@ -43,7 +43,9 @@ out = Path(args.out)
 def default_k(h, T):
     """The largest k = T/N <= 0.8 k_max (stability.py on the mesh of size h)."""
     from damage_dolfinx.numerics.stability import SAFETY
-    probe = examples.get(EXAMPLE).build(comm, h=h, k=T / 1e6, T=T)
+    from damage_dolfinx.numerics.stability_bound import exact_estimates
+    with exact_estimates():
+        probe = examples.get(EXAMPLE).build(comm, h=h, k=T / 1e6, T=T)
     k_max = probe.stability["k_max"]
     return T / math.ceil(T / (SAFETY * k_max)), k_max
 

@@ -33,6 +33,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics.constitutive import eps
 from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
 from damage_dolfinx.numerics.solvers import SolveContext
@@ -288,8 +289,10 @@ class Model:
         K.mult(u, y)
         eps_sq = u.dot(y)
         zeta_integral = m.dot(compat.petsc_vec(self.zeta))
+        owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
+        (zeta_min,), (zeta_max,) = bookkeeping.extrema(self.comm, [owned], [owned])
         return {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
-                "zeta_min": float(self.zeta_min()), "zeta_max": float(self.zeta_max()),
+                "zeta_min": zeta_min, "zeta_max": zeta_max,
                 "zeta_mean": float(zeta_integral / area)}
 
     def _assemble_norm_operators(self):
@@ -299,10 +302,7 @@ class Model:
                  compat.form(ufl.inner(eps(du), eps(w)) * ufl.dx)]
         mats = []
         for a in forms:
-            A = compat.create_matrix(a)
-            compat.assemble_matrix(A, a, [])
-            A.assemble()
-            mats.append(A)
+            mats.append(bookkeeping.norm_matrix(a, V.dofmap.index_map_bs))
         m_form = compat.form(ufl.TestFunction(Z) * ufl.dx)
         m = compat.create_vector(m_form)
         with m.localForm() as ml:

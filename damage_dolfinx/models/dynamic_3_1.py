@@ -35,6 +35,7 @@ from mpi4py import MPI
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
@@ -150,13 +151,13 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         action = x.get("stability_check", "warn")
         if action == "off":
             return {}
-        from damage_dolfinx.numerics.stability import check_time_step, estimate_stability
+        from damage_dolfinx.numerics.stability import checked, estimate_stability
         start = time.perf_counter()
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
-                                 bcs=self.bcs, normal=self.n_facet)
+                                 bcs=self.bcs, normal=self.n_facet, k=self.k)
         where = f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate"
-        out["k_over_k_max"] = check_time_step(self.k, out["k_max"], where, action=action)
+        checked(out, self.k, where, action)
         out["time_s"] = time.perf_counter() - start
         return out
 
@@ -170,9 +171,8 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
     def u_max(self) -> float:
         """max over the nodes of |u_n| (the L-shape comparison of Example 3)."""
         owned = self.u.function_space.dofmap.index_map.size_local
-        u = self.u.x.array.reshape(-1, self.mesh.topology.dim)[:owned]
-        return self.comm.allreduce(float(np.linalg.norm(u, axis=1).max()) if owned else 0.0,
-                                   op=MPI.MAX)
+        d = self.mesh.topology.dim
+        return bookkeeping.max_node_norm(self.u.x.array[:owned * d], d, self.comm)
 
     def scalars(self) -> dict:
         out = super().scalars()

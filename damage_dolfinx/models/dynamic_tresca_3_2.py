@@ -32,7 +32,7 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
-from damage_dolfinx.numerics.stability import check_time_step, estimate_k_max
+from damage_dolfinx.numerics.stability import checked, estimate_stability
 from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
@@ -132,11 +132,12 @@ class DynamicTresca(Model):
         if action == "off":
             return None
         p = self.params  # Tresca adds no explicit stiffness: c_nu = 0; eta_* Phi_L only lowers B
-        k_max = estimate_k_max(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
-                               bcs=self.bcs)
+        out = estimate_stability(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
+                                 bcs=self.bcs, k=self.k)
         where = f"{self.data.example_id}: explicit elastic force, eigenvalue estimate"
-        check_time_step(self.k, k_max, where, action=action)
-        return float(k_max)
+        checked(out, self.k, where, action)
+        self.k_max_lower_bound = out.get("k_max_lower_bound")
+        return None if out["k_max"] is None else float(out["k_max"])
 
     # -- measured tangential displacement on named contact faces (Example 2: top vs bottom)
     def _faces_setup(self, faces: dict):
@@ -161,4 +162,7 @@ class DynamicTresca(Model):
                 "friction_solver": self.friction.name, **iteration_counters(self.friction)}
 
     def summary_extra(self) -> dict:
-        return {} if self.k_max is None else {"k_max": self.k_max}
+        out = {} if self.k_max is None else {"k_max": self.k_max}
+        if getattr(self, "k_max_lower_bound", None) is not None:
+            out["k_max_lower_bound"] = self.k_max_lower_bound  # no eigensolve: k below it
+        return out

@@ -258,17 +258,16 @@ class FullyDamageableContact(Model):
         action = x.get("stability_check", "warn")
         if action == "off":
             return {}
-        from damage_dolfinx.numerics.stability import check_time_step, estimate_stability
+        from damage_dolfinx.numerics.stability import checked, estimate_stability
         start = time.perf_counter()
         has_contact = self.comm.allreduce(
             int(np.sum(self.data.geometry.facet_tags.values == GAMMA_C)), op=MPI.SUM) > 0
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if has_contact else 0.0, dsC=dsC, bcs=self.bcs,
-                                 normal=self.n_facet)
-        out["k_over_k_max"] = check_time_step(
-            self.k, out["k_max"],
-            f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate",
-            action=action if self.elastic_term == "explicit" else "off")
+                                 normal=self.n_facet, k=self.k)
+        checked(out, self.k,
+                f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate",
+                action=action if self.elastic_term == "explicit" else "off")
         out["time_s"] = time.perf_counter() - start
         return out
 

@@ -29,7 +29,6 @@ would carry over (S + D with a block-diagonal D), but it is kept 2-D only; 3-D u
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -142,6 +141,7 @@ class DiagonalUpdateSolver:
         if self._K_cho is None or not np.array_equal(K_all, self._K_cho):
             M = self.S + np.diag(K_all)
             try:
+                import scipy.linalg  # on first use: 35 ms of import a run may not need
                 L = scipy.linalg.cholesky(M, lower=True)
             except np.linalg.LinAlgError:
                 return False
@@ -157,6 +157,7 @@ class DiagonalUpdateSolver:
         self.A_IC.multTranspose(y_I, s_C)               # b_C - A_CI y
         b_C.axpy(-1.0, s_C)
         w["to_all"].scatter(b_C, w["s_all"], ins, fwd)
+        import scipy.linalg
         x_C_all = scipy.linalg.cho_solve(self._cho, w["s_all"].getArray(readonly=True))
         x_C.setArray(x_C_all[self._c_lo:self._c_hi])
         self.A_IC.mult(x_C, s_I)                        # x_I = A_II^{-1} (b_I - A_IC x_C)

@@ -25,6 +25,9 @@ scheme is stable iff
   4-6 eigensolves). For 3.1 Ex. 1 this gives k_max = 0.0129-0.0146 (n = 128 ... 4) where the
   closed form says 0.2; measured onsets of chatter lie within 4% above it.
 
+Cheap first (:func:`estimate_stability`): a lower bound of k_max with no eigensolve
+(stability_bound.py); the eigenvalues below only when the time step is above it.
+
 Eigenvalues (:func:`largest_eigenvalue`): SLEPc Krylov-Schur (GHEP, options prefix
 ``stability_``) when slepc4py can be imported, else power iteration with one MUMPS factorisation
 of M; both handle Dirichlet rows (see there).
@@ -41,6 +44,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
+from damage_dolfinx.numerics import stability_bound
 from damage_dolfinx.numerics.constitutive import B, eps
 from damage_dolfinx.parameters import InputError
 
@@ -78,8 +82,8 @@ def check_time_step(k: float, k_max: float, where: str, action: str = "warn") ->
                f"scheme's explicit terms ({where}, k/k_max = {ratio:.3g}); use "
                f"k <= {SAFETY * k_max:.4g} (0.8 k_max)")
     if action == "error":
-        raise InputError(message + ", or --allow-unstable (Problem(allow_unstable=True)) to run "
-                         "it anyway")
+        raise InputError(message + " (problem.k_max() gives k_max before the run), or "
+                         "allow_unstable=True to run it anyway")
     if MPI.COMM_WORLD.rank == 0:
         print(f"WARNING: {message}", file=sys.stderr, flush=True)
     return ratio
@@ -288,11 +292,42 @@ def stiffness_and_mass(V, E, nu, rho, c_nu=0.0, dsC=None, bcs=(), normal=None):
 
 
 def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal=None,
-                       method="auto") -> dict:
+                       method="auto", k=None) -> dict:
     """omega^2_max of (K_B + K_c, M) and the time-step limit k_max of the scheme (module
     docstring): the closed form without contact, the non-proportional iteration with it.
-    ``method``: eigenvalue solver of :func:`largest_eigenvalue`."""
+    ``method``: eigenvalue solver of :func:`largest_eigenvalue`.
+
+    First the cheap sufficient test (stability_bound.py, no eigensolve): a proven lower bound
+    k_max_lower_bound <= k_max. With a time step ``k`` at or below it the answer is clear and no
+    eigenvalue is computed: ``k_max`` is None and ``decided_by`` is ``bound`` (inside
+    stability_bound.exact_estimates() the eigensolve runs all the same). Otherwise the
+    eigensolved k_max, kept in memory by a hash of the matrices and m_visc (``decided_by``:
+    ``eigensolve`` or ``cache``)."""
     K_B, K, M = stiffness_and_mass(V, E, nu, rho, c_nu, dsC, bcs, normal)
+    try:
+        rstart, rend = K.getOwnershipRange()
+        free = np.ones(rend - rstart, dtype=bool)
+        free[_isolated_rows(K, M)] = False
+        out = stability_bound.bound(V, K_B, K, M, m_visc, free)
+        lower = out.get("k_max_lower_bound", 0.0)
+        if k is not None and k <= lower and not stability_bound.exact_requested():
+            return {**out, "k_max": None, "decided_by": "bound"}
+        method_used = "slepc" if method != "power" and _slepc() else "power"
+        key = stability_bound.key((K_B, K, M), float(m_visc), method_used)
+        exact = stability_bound.cached(key)
+        decided_by = "cache"
+        if exact is None:
+            decided_by = "eigensolve"
+            exact = _eigensolved(K_B, K, M, m_visc, method)
+            exact["eigen_method"] = method_used
+            stability_bound.store(key, exact)
+        return {**out, **exact, "decided_by": decided_by}
+    finally:
+        for A in {id(a): a for a in (K_B, K, M)}.values():
+            A.destroy()
+
+
+def _eigensolved(K_B, K, M, m_visc, method) -> dict:
     omega2 = largest_eigenvalue(K, M, tol=EIG_TOL, method=method)
     k_prop = critical_time_step(omega2, m_visc)
     if K is K_B or math.isinf(m_visc):
@@ -302,11 +337,17 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
         C.scale(1.0 / m_visc)
         k_max = k_max_nonproportional(K, M, C, m_visc, method=method, omega2=omega2)
         C.destroy()
-    for A in {id(a): a for a in (K_B, K, M)}.values():
-        A.destroy()
     return {"omega2_max": omega2, "k_max": k_max, "k_max_proportional_formula": k_prop,
-            "k_suggested": SAFETY * k_max,
-            "eigen_method": "slepc" if method != "power" and _slepc() else "power"}
+            "k_suggested": SAFETY * k_max}
+
+
+def checked(out: dict, k: float, where: str, action: str) -> dict:
+    """check_time_step on the result of :func:`estimate_stability`: k/k_max where the
+    eigensolve ran; where the bound decided, k/k_max_lower_bound (<= 1, an upper bound of
+    k/k_max) and nothing to say."""
+    limit = out["k_max"] if out.get("k_max") is not None else out["k_max_lower_bound"]
+    out["k_over_k_max"] = check_time_step(k, limit, where, action=action)
+    return out
 
 
 def estimate_k_max(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal=None) -> float:
@@ -316,6 +357,6 @@ def estimate_k_max(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal=Non
     omega^2_max the largest eigenvalue of (K_B, M_rho). With contact the contact stiffness
     c_nu (u.nu)(w.nu) ds is undamped, the closed form would overestimate k_max (up to ~15x for
     3.1 Ex. 1) and the exact limit of the scheme, the smallest k with 4M + 2kC - k^2(K_B + K_c)
-    singular, is returned (:func:`k_max_nonproportional`).
+    singular, is returned (:func:`k_max_nonproportional`). Always eigensolved (or cached).
     """
     return estimate_stability(V, E, nu, rho, m_visc, c_nu, dsC, bcs, normal)["k_max"]

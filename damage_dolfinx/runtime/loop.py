@@ -12,6 +12,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from damage_dolfinx import departures
+from damage_dolfinx.numerics.contact_output import ContactOutput
 from damage_dolfinx.numerics.solvers import ConvergenceError
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.runtime import checkpoint, io
@@ -39,14 +40,14 @@ class Run(RunRecords):
         if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
                 or every < 1:
             raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
-        for name, value in (("--write-every", write_every),
-                            ("--checkpoint-every", checkpoint_every)):
+        for name, value in (("write_every", write_every),
+                            ("checkpoint_every", checkpoint_every)):
             if value is not None and (isinstance(value, bool) or not isinstance(value, int)
                                       or value < 1):
                 raise InputError(f"{name} must be a whole number >= 1, got {value!r}")
         if not (isinstance(checkpoint_seconds, (int, float)) and checkpoint_seconds >= 0
                 and math.isfinite(checkpoint_seconds)):
-            raise InputError(f"--checkpoint-seconds must be a finite number >= 0 (0: none), "
+            raise InputError(f"checkpoint_seconds must be a finite number >= 0 (0: none), "
                              f"got {checkpoint_seconds!r}")
         if mesh_file is not None:
             check_mesh_file(mesh_file, ex.dim, lambda: ex.mesh_requirements()[1], comm=comm)
@@ -96,13 +97,14 @@ class Run(RunRecords):
                     print(f"damage-dolfinx: nothing to do: the run in {str(self.out)!r} ended "
                           f"({previous['status']}) at t = {previous['t_final']:.6g} after "
                           f"{previous['steps_done']} steps; its outputs are unchanged"
-                          + (" (a larger --T continues it)" if previous["status"] == "completed"
+                          + (" (a larger T continues it)" if previous["status"] == "completed"
                              else ""), flush=True)
                 self.summary = previous
                 return False
         self.xdmf_name = f"fields_from_step{resume[1]['step']}.xdmf" if resume else "fields.xdmf"
         planned = {"summary.json", "history.csv", self.xdmf_name, self.xdmf_name[:-5] + ".h5",
-                   self.xdmf_name + ".bak", "fields_final.npz", "checkpoint.json",
+                   self.xdmf_name + ".bak", "fields.xdmf", "fields.xdmf.tmp", "fields_final.npz",
+                   "checkpoint.json",
                    *checkpoint.GENERATIONS, *(fig.filename for fig in ex.figures
                                                if o["figures"])}
         description = previous["description"] if previous else None
@@ -116,6 +118,8 @@ class Run(RunRecords):
                       "output time (the run was killed while writing it)", file=sys.stderr,
                       flush=True)
         self._build_model(mesh_file)
+        self.settings["fingerprint"] = checkpoint.verify_fingerprint(self.ex, self.stepper,
+                                                                     self.resume, self.out)
         claim_folder(*claim)
         self._check_checkpoints()
         self._open_summary(params, n)
@@ -131,6 +135,7 @@ class Run(RunRecords):
                                       mesh_file, self.configured), "cannot set up the solvers")
         except ConvergenceError as exc:
             raise InputError(str(exc)) from None
+        ContactOutput.for_model(self.stepper)  # contact quantities in history.csv and XDMF
 
     def _check_checkpoints(self):
         stepper, o = self.stepper, self.options
@@ -180,13 +185,15 @@ class Run(RunRecords):
         files = {}
 
         def open_files():
-            files["xdmf"] = io.XDMFSeries(out / self.xdmf_name, stepper.mesh)
+            files["xdmf"] = io.XDMFSeries(out / self.xdmf_name, stepper.mesh, out / "fields.xdmf",
+                                          self.resume["t"] if self.resume else None)
             files["history"] = io.CSVHistory(out / "history.csv", columns, comm,
                                              keep_until_step=self.resume["step"]
                                              if self.resume else None)
         io.collective(comm, out, f"{self.xdmf_name} / history.csv (opening)", open_files)
         self.columns = set(columns)
         self.xdmf, self.history = files["xdmf"], files["history"]
+        self.summary["outputs"].update(io.series_outputs(self.xdmf))
         self.report = Progress(self.ex.id, self.N, comm, enabled=self.options["progress"])
         # models without track() compute their scalars (whatever they keep track of stays right)
         self.track = getattr(stepper, "track", None) or stepper.scalars
@@ -218,7 +225,8 @@ class Run(RunRecords):
             checkpoint.load(self.path, stepper.checkpoint_state())
             stepper.restore(self.resume["step"])
             self.check_state()
-            stats, scalars = {}, stepper.scalars()
+            stats = {}
+            scalars = self.record(stats, 0.0, row=False)  # the summary from the state on disk
             self.write_fields()
         else:
             stats = solver_step(stepper.initialize, self.at("the initial solve"))
