@@ -215,15 +215,19 @@ def _check_boundaries(boundaries, info):
         if role not in allowed:
             raise InputError(f"boundaries: role {role!r} is not one of model {info.id}'s: "
                              f"{', '.join(allowed)}")
-        listed = [tags] if is_real(tags) else tags
-        if isinstance(listed, (str, bytes, dict)) or not hasattr(listed, "__iter__"):
-            raise InputError(f"boundaries[{role!r}] must be a facet tag or a list of tags, got "
-                             f"{_shown(tags)}")
+        listed = [tags] if is_real(tags) or isinstance(tags, str) else tags
+        if isinstance(listed, (bytes, dict)) or not hasattr(listed, "__iter__"):
+            raise InputError(f"boundaries[{role!r}] must be a facet tag, a gmsh physical name "
+                             f"or a list of these, got {_shown(tags)}")
         listed = list(listed)
         if not listed:
             raise InputError(f"boundaries[{role!r}] lists no facet tag")
         for tag in listed:
-            whole(f"boundaries[{role!r}] (a facet tag)", tag, low=0)
+            if isinstance(tag, str):  # a gmsh physical name: looked up on the mesh (meshes.py)
+                if not tag.strip():
+                    raise InputError(f"boundaries[{role!r}]: an empty physical name")
+                continue
+            whole(f"boundaries[{role!r}] (a facet tag or a gmsh physical name)", tag, low=0)
     return set(boundaries)
 
 
