@@ -210,8 +210,7 @@ def _check_boundaries(boundaries, info):
     if not isinstance(boundaries, dict) or not boundaries:
         raise InputError("boundaries must be a dict {role: tag or [tags]}, got "
                          f"{_shown(boundaries)}")
-    allowed = tuple(info.boundary_roles()) if hasattr(info, "boundary_roles") else \
-        ("clamped", "traction") + tuple(info.contact_roles)
+    allowed = tuple(info.boundary_roles())  # the model's declaration (Model.boundary_roles)
     for role, tags in boundaries.items():
         if role not in allowed:
             raise InputError(f"boundaries: role {role!r} is not one of model {info.id}'s: "
