@@ -19,8 +19,8 @@ Contact laws:
     :func:`normal_compliance_pressure` p_nu(u.nu - g) = c_nu (u.nu - g)_+ and
     :func:`normal_compliance_term` (its boundary integral); :func:`bilateral` (u.nu = 0 on
     faces parallel to coordinate planes, a component Dirichlet condition); Tresca friction
-    j(w) = int g |w_tau| through :class:`FrictionProblem` and a friction solver;
-    :func:`coulomb_bound` the simplified Coulomb bound mu_f |S_n| (a Tresca bound g).
+    j(w) = int g abs(w_tau) through :class:`FrictionProblem` and a friction solver;
+    :func:`coulomb_bound` the simplified Coulomb bound mu_f abs(S_n) (a Tresca bound g).
 Friction solvers (second-kind inequalities, prefix ``friction_``):
     :class:`RegularisedNewton` (Newton on the regularised law Phi_eps), :func:`friction_solver`
     (a solver by name: ``newton``, or a registered alternative), :data:`FRICTION_DEFAULTS`.
@@ -68,6 +68,6 @@ __all__ = ["B", "ConvergenceError", "DamageLaw", "DamageStep", "FRICTION_DEFAULT
 
 
 def coulomb_bound(mu_f, S_n):
-    """The simplified Coulomb friction bound g = mu_f |S_n| for a prescribed normal stress S_n
+    """The simplified Coulomb friction bound g = mu_f abs(S_n) for a prescribed normal stress S_n
     (Section 2.4, P2): Tresca friction with this bound."""
     return mu_f * abs(S_n)

@@ -148,6 +148,9 @@ def _api_page():
         obj = getattr(damage_dolfinx, name)
         if inspect.ismodule(obj):
             kind, directive = "Modules", f".. automodule:: {obj.__name__}\n   :members:"
+            shared = sorted(n for n in names if n != name and hasattr(obj, n))
+            if shared:  # documented once, at the top level
+                directive += f"\n   :exclude-members: {', '.join(shared)}"
         elif inspect.isclass(obj):
             kind, directive = "Classes", f".. autoclass:: damage_dolfinx.{name}\n   :members:"
         elif inspect.isroutine(obj):
