@@ -99,9 +99,16 @@ def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="er
     ax.set_ylabel(f"error {norms}", fontsize=8)
     ax.tick_params(axis="y", labelsize=7)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=6.5, loc="best")
+    ax.legend(fontsize=6, loc="lower right", framealpha=0.85)
     figstyle.log_tick_labels(ax)
     ax.xaxis.set_minor_formatter(NullFormatter())
+    lo, hi = ax.get_ylim()
+    if hi / lo < 10:  # less than a decade: a label at every tick of the error axis
+        from matplotlib.ticker import FuncFormatter, LogLocator
+        ax.yaxis.set_minor_locator(LogLocator(subs=np.arange(1, 10)))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+        ax.tick_params(axis="y", which="minor", labelsize=7)
     name = title or example_id
     fig.tight_layout()
     ax.set_title(f"{name}\nconvergence in {norms}\nreference $n$ = {ref_n}, $k$ = {ref_k:g}",
