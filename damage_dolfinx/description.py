@@ -164,7 +164,9 @@ class Example:
         if h is not None and not h > 0:
             raise InputError(f"mesh size h must be positive, got h = {h}")
         if mesh_file is not None and not Path(mesh_file).is_file():
-            raise InputError(f"mesh file {str(mesh_file)!r} does not exist")
+            from damage_dolfinx.validation import mesh_path_problem
+            raise InputError(f"mesh file {str(mesh_file)!r} "
+                             f"{mesh_path_problem(Path(mesh_file)) or 'is not a file'}")
         if time.num_steps > MAX_STEPS and not allow_long:
             raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
                              f"{MAX_STEPS:.0e}; choose a larger k, or allow_long=True")
@@ -210,6 +212,8 @@ class Example:
         geometry = retag(geometry, self.boundaries, required, model_info(self.model))
         data = ProblemData(self.id, geometry, params, time, self.body_force, self.traction,
                            self.zeta0, self.builders, self.damage_law, self.irreversible)
+        from damage_dolfinx.validation import check_data
+        check_data(data)  # loads, law, zeta0 against the mesh (validation.py)
         from damage_dolfinx.models.registry import model as model_info
         return model_info(self.model)(data)
 

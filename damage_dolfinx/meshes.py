@@ -33,6 +33,10 @@ def _check_model(dim):
                     "it holds no mesh")
         if dim is not None and d != dim:
             return f"it holds a {d}-D mesh; this problem is {dim}-D"
+        from damage_dolfinx.validation import cell_types_problem
+        mixed = cell_types_problem(gmsh, d)
+        if mixed:
+            return mixed
         groups = gmsh.model.getPhysicalGroups()
         if not any(g[0] == d for g in groups):
             return (f"no physical {'surface' if d == 2 else 'volume'} holds the cells: tag them "
@@ -59,9 +63,9 @@ def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     """A gmsh ``.msh`` file as a :class:`~damage_dolfinx.geometries.Geometry` (mesh and facet
     tags), read on rank 0 and distributed over ``comm``. ``dim``: the dimension the problem
     needs (None: the file's). Raises InputError with the file name and what is wrong."""
+    from damage_dolfinx.validation import check_mesh_reading
+    check_mesh_reading(path, dim)
     path = Path(path)
-    if not path.is_file():
-        raise InputError(f"mesh file {str(path)!r} does not exist")
     if path.suffix.lower() != ".msh":
         raise InputError(f"mesh file {str(path)!r}: expected a gmsh .msh file")
     if path.stat().st_size == 0:
@@ -85,6 +89,8 @@ def from_gmsh(model=None, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     """The mesh of a gmsh model (default: the current ``gmsh.model``, meshed, on rank 0)."""
     from damage_dolfinx import compat
     import gmsh
+    from damage_dolfinx.validation import check_dim
+    check_dim(dim)
     model = model or gmsh.model
     error = _check_model(dim)(gmsh) if comm.rank == 0 else None
     error = comm.bcast(error, root=0)
@@ -143,7 +149,7 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
     """The geometry with its facet tags renamed to the roles the models read (1 clamped,
     2 traction, 3 contact), from ``boundaries`` = {role: tag or tags}; None keeps the tags as
     they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty.
-    ``model``: the model class, whose ``contact_roles`` are the contact roles allowed."""
+    ``model``: the model class, whose ``boundary_roles()`` are the roles allowed."""
     from damage_dolfinx import compat
     from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION
     counts = tag_counts(geometry)
@@ -153,8 +159,9 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
             raise InputError(f"{where}: the {what} tag {tag} is missing or empty")
     if boundaries is None:
         return geometry
-    allowed = ("clamped", "traction") + (model.contact_roles if model else CONTACT_ROLES)
-    internal = {"clamped": CLAMPED, "traction": TRACTION}
+    internal = model.boundary_roles() if model else \
+        {"clamped": CLAMPED, "traction": TRACTION, **{r: CONTACT for r in CONTACT_ROLES}}
+    allowed = tuple(internal)
     mapping = {}
     for role, tags in boundaries.items():
         if role not in allowed:
@@ -166,7 +173,7 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
                                  f"(tags present: {sorted(counts) or 'none'})")
             if int(tag) in mapping:
                 raise InputError(f"facet tag {int(tag)} is given two roles")
-            mapping[int(tag)] = internal.get(role, CONTACT)
+            mapping[int(tag)] = internal[role]
     ft = geometry.facet_tags
     keep = np.isin(ft.values, list(mapping))
     values = np.array([mapping[int(v)] for v in ft.values[keep]], dtype=np.int32)

@@ -118,6 +118,8 @@ class Problem:
         from damage_dolfinx.laws import DamageLaw
         from damage_dolfinx.meshes import as_geometry
         from damage_dolfinx.models.registry import model
+        from damage_dolfinx.validation import check_problem
+        self = check_problem(self)  # every argument, before any work (validation.py)
         info = model(self.model)
         if self.damage_law is not None and not isinstance(self.damage_law, DamageLaw):
             raise InputError("damage_law must be a damage_dolfinx.DamageLaw "

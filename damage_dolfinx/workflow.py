@@ -14,7 +14,8 @@ def _named(problem):
 
 
 def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
+        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD,
+        on_step=None) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
     ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
     ``out/summary.json``).
@@ -28,6 +29,9 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     checkpoint. Under ``mpirun`` every rank calls it; only rank 0 prints. ``n``, ``k``, ``T``
     override the problem's own. ``fields.xdmf`` is one time series from t = 0 to the last step
     whatever restarts happened; :func:`~damage_dolfinx.read_run` reads the folder back.
+    ``on_step(step)``: called after the initial state and after every step with the
+    :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
+    the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
 
     Raises (all importable from ``damage_dolfinx``; damage_dolfinx.errors):
 
@@ -41,10 +45,40 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     * :class:`~damage_dolfinx.RunInterrupted`: SIGTERM, SIGINT or SIGUSR1 stopped the run at the
       end of a step after a checkpoint (summary.json "interrupted"; ``restart=True`` goes on).
     """
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.runner import run as _run
-    return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
-                checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                comm=comm)
+    from damage_dolfinx.validation import check_run
+    with outcome(comm):
+        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out)
+        n, k, T, restart, overwrite = (checked[key] for key in ("n", "k", "T", "restart",
+                                                                 "overwrite"))
+        checkpoint_every, progress, figures = (checked[key] for key in (
+            "checkpoint_every", "progress", "figures"))
+        return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                    checkpoint_every=checkpoint_every, progress=progress, figures=figures,
+                    comm=comm, on_step=on_step)
+
+
+def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
+          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD):
+    """The run of :func:`run` (the same arguments, the same run folder), step by step::
+
+        for step in dd.steps(problem, "results/mine"):
+            R = step.contact_resultant()       # int_{Gamma_C} p nu ds, every rank
+            if R is not None and abs(R[1]) > 2.0:
+                break                          # the run stops here: status "stopped"
+
+    Each ``step`` (:class:`~damage_dolfinx.runtime.runner.Step`, after the initial state and
+    after every step) has ``n``, ``t``, the model and its live Functions ``u``, ``zeta``, ``v``
+    (None where the scheme has none), ``contact_pressure`` (UFL, None without normal contact),
+    ``contact_resultant()`` and the ``summary`` so far. Leaving the loop stops the run at that
+    step with its outputs and a checkpoint (``restart=True`` continues it). Under MPI every
+    rank iterates and must stop at the same step (decide from collective values, as
+    ``contact_resultant()`` is). Bad input raises InputError here, before any work."""
+    from damage_dolfinx.runtime.loop import Run
+    return Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
+                       overwrite=overwrite, checkpoint_every=checkpoint_every,
+                       progress=progress, figures=figures, comm=comm).steps()
 
 
 def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
@@ -55,9 +89,13 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     mesh`` of nested structured meshes (:func:`damage_dolfinx.geometries.rectangle.rectangle`):
     coarse solutions are transferred to the reference mesh exactly. Every n must divide
     ``ref_n`` and every k must be a multiple of ``ref_k``."""
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=list(n), ks=list(k), T=T,
-                 progress=progress, comm=comm)
+    from damage_dolfinx.validation import check_converge
+    with outcome(comm):
+        n, k, ref_n, ref_k, T = check_converge(n, k, ref_n, ref_k, T)
+        return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
+                     progress=progress, comm=comm)
 
 
 def gather(function):

@@ -38,6 +38,13 @@ def prepare_output_dir(path, comm=MPI.COMM_WORLD) -> Path:
     error = None
     if comm.rank == 0:
         try:
+            if path.is_symlink() and not path.exists():
+                raise OSError(0, "it is a symbolic link to nothing (dangling, or a loop of links)")
+            if path.exists() and not path.is_dir():
+                raise OSError(0, "it is a file, not a folder")
+            if not path.exists():
+                from damage_dolfinx.runtime.collective import created
+                created(path)  # removed again if the call is refused while it is empty
             path.mkdir(parents=True, exist_ok=True)
             probe = path / f".damage-dolfinx-write-test-{os.getpid()}"  # never a user's file
             os.close(os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600))

@@ -127,6 +127,8 @@ class Run(RunRecords):
                       "output time (the run was killed while writing it)", file=sys.stderr,
                       flush=True)
         self._build_model(mesh_file)
+        self.settings["fingerprint"] = checkpoint.verify_fingerprint(self.ex, self.stepper,
+                                                                     self.resume, self.out)
         claim_folder(*claim)
         self._check_checkpoints()
         self._open_summary(params, n)
@@ -232,7 +234,8 @@ class Run(RunRecords):
             checkpoint.load(self.path, stepper.checkpoint_state())
             stepper.restore(self.resume["step"])
             self.check_state()
-            stats, scalars = {}, stepper.scalars()
+            stats = {}
+            scalars = self.record(stats, 0.0, row=False)  # the summary from the state on disk
             self.write_fields()
         else:
             stats = solver_step(stepper.initialize, self.at("the initial solve"))
