@@ -283,8 +283,7 @@ def fingerprint(ex, stepper) -> dict:
         out["zeta0"] = f"function of x in [{digest[0]:.9g}, {digest[1]:.9g}]"
     else:
         out["zeta0"] = float(z0)
-    out["boundaries"] = repr(sorted((str(k), v if isinstance(v, (int, np.integer)) else
-                                     sorted(map(int, v)))
+    out["boundaries"] = repr(sorted((str(k), _tags(v))
                                     for k, v in (ex.boundaries or {}).items()))
     out["irreversible"] = bool(data.irreversible)
     out["reading"] = getattr(ex, "reading", None)
@@ -317,3 +316,13 @@ def verify_fingerprint(ex, stepper, meta, out) -> dict:
                                  f"{str(out)!r} (checkpoint: {saved.get(key)!r}, this run: "
                                  f"{fp.get(key)!r}); choose another --out to run it")
     return fp
+
+
+def _tags(v):
+    """A boundary entry as the fingerprint holds it: a tag, a gmsh physical name, or a sorted
+    list of them (numbers as numbers, names as names)."""
+    if isinstance(v, (int, np.integer, str)):
+        return v if isinstance(v, str) else int(v)
+    if all(not isinstance(x, str) for x in v):
+        return sorted(map(int, v))
+    return sorted(map(str, v))
