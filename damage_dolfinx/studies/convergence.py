@@ -493,7 +493,8 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
             write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
             label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
             plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k,
-                             definition, title=getattr(ex, "title", None))
+                             definition, title=f"{ex.id} (model {ex.model_id})" if ex.own
+                             else f"{label}: {ex.title}")
     io.collective(comm, out, "the tables and convergence.png", tables)  # OutputError: exit 4
     if comm.rank == 0:
         if progress:  # progress=False prints nothing

@@ -93,7 +93,12 @@ def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="er
     ax.xaxis.set_minor_locator(NullLocator())
     ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_xticks(levels)
-    ax.set_xticklabels([f"{v:.3g}" for v in levels], rotation=60, fontsize=7)
+    labels, last = [], None
+    for v in levels:  # a tick at every level; a label where it does not overlap the previous
+        show = last is None or np.log10(v / last) > 0.07
+        labels.append(f"{v:.3g}" if show else "")
+        last = v if show else last
+    ax.set_xticklabels(labels, rotation=60, fontsize=7)
     ax.set_xlabel("mesh size + time step, $h + k$ (length + time units)", fontsize=8)
     norms = figstyle.error_mathtext(definition)
     ax.set_ylabel(f"error {norms}", fontsize=8)
@@ -101,6 +106,9 @@ def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="er
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=6, loc="lower right", framealpha=0.85)
     figstyle.log_tick_labels(ax)
+    from matplotlib.ticker import FixedFormatter
+    ax.xaxis.set_major_locator(FixedLocator(levels))
+    ax.xaxis.set_major_formatter(FixedFormatter(labels))
     ax.xaxis.set_minor_formatter(NullFormatter())
     lo, hi = ax.get_ylim()
     if hi / lo < 10:  # less than a decade: a label at every tick of the error axis
