@@ -229,6 +229,22 @@ def _norm_statement(components) -> str:
     return ", ".join(f"{name}: {words[norm]}" for name, _, norm in components)
 
 
+def _check_states(ref, runs, comm, when):
+    """Stop the study (ConvergenceError on every rank) when the reference or a cell holds a
+    NaN/inf or a zeta outside [zeta*, 1] (guards.state_problem; one allreduce)."""
+    from damage_dolfinx.runtime.guards import state_problem
+    detail = None
+    for name, stepper in [("the reference", ref)] + [
+            (f"the cell n = {r.n}, k = {r.k:g}", r.stepper) for r in runs if r.mine]:
+        if stepper is not None and detail is None:
+            code, text = state_problem(stepper)
+            detail = f"{name} at {when}: {text}" if code else None
+    if comm.allreduce(1 if detail else 0, op=MPI.MAX):
+        detail = next(d for d in comm.allgather(detail) if d)
+        raise ConvergenceError(f"{detail}; the study is stopped (the model or its data gave "
+                               "numbers that cannot be right)")
+
+
 def _component_norms(ref):
     """{name: ComponentNorm} of the reference stepper's ``error_components``."""
     return {name: post.ComponentNorm(f, norm) for name, f, norm in ref.error_components}
@@ -420,6 +436,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
     for run in runs:
         if run.mine:
             run.advance(initial=True)
+    _check_states(ref, runs, comm, "t = 0")
     for run in runs:
         run.measure()
     step, measure_wall = 0, 0.0
@@ -436,6 +453,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
         for run in due:
             if run.owner is None:
                 run.advance()
+        _check_states(ref, due, comm, f"step {step} of the reference")
         start = time.perf_counter()
         for run in due:
             run.measure()
