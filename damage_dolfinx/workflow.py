@@ -86,9 +86,14 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
     run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
     and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
-    mesh`` of nested structured meshes (:func:`damage_dolfinx.geometries.rectangle.rectangle`):
-    coarse solutions are transferred to the reference mesh exactly. Every n must divide
-    ``ref_n`` and every k must be a multiple of ``ref_k``."""
+    mesh``, the coarse levels below ``ref_n``, every k a multiple of ``ref_k``. Nested
+    structured meshes (:func:`damage_dolfinx.geometries.rectangle.rectangle`; every n divides
+    ``ref_n``) are transferred to the reference mesh exactly; any other family (a gmsh family,
+    e.g. :func:`damage_dolfinx.geometries.plate_with_hole.plate_with_hole_family`) by exact
+    point evaluation of the coarse fields at the reference mesh's nodes (P1) and cell midpoints
+    (DG0); a family whose meshes do not cover the same domain is refused before any step.
+    The summary states the norm (``norm``, ``error_definition``) and the comparison
+    (``comparison``). ``progress=False`` prints nothing."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
     from damage_dolfinx.validation import check_converge

@@ -25,7 +25,7 @@ from damage_dolfinx import cli
     (["run", "2.1-ex1", "--h", "0.1"], "structured mesh"),
     (["run", "2.1-ex2a", "--n", "10"], "gmsh mesh"),
     (["run", "2.1-ex2a", "--mesh", "/nonexistent/disc.msh"], "does not exist"),
-    (["converge", "2.1-ex2a"], "no nested structured meshes"),
+    (["converge", "2.1-ex2a"], "has no mesh family"),
     (["converge", "2.1-ex1", "--ref-n", "40", "--n", "15"], "not nested"),
     (["converge", "2.1-ex1", "--ref-k", "0.003", "--k", "0.01"], "must divide every coarse k"),
     (["run", "2.1-ex1", "--history-every", "0"], "history_every must be a whole number >= 1"),

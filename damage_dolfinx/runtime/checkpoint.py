@@ -283,9 +283,8 @@ def fingerprint(ex, stepper) -> dict:
         out["zeta0"] = f"function of x in [{digest[0]:.9g}, {digest[1]:.9g}]"
     else:
         out["zeta0"] = float(z0)
-    def tags(v):  # facet tags or gmsh physical names, one or a list
-        return sorted(map(str, [v] if isinstance(v, (int, np.integer, str)) else v))
-    out["boundaries"] = repr(sorted((str(k), tags(v)) for k, v in (ex.boundaries or {}).items()))
+    out["boundaries"] = repr(sorted((str(k), _tags(v))
+                                    for k, v in (ex.boundaries or {}).items()))
     out["irreversible"] = bool(data.irreversible)
     out["reading"] = getattr(ex, "reading", None)
     out["builders"] = repr(sorted((str(k), repr(v) if not callable(v) else "function")
@@ -317,3 +316,13 @@ def verify_fingerprint(ex, stepper, meta, out) -> dict:
                                  f"{str(out)!r} (checkpoint: {saved.get(key)!r}, this run: "
                                  f"{fp.get(key)!r}); choose another --out to run it")
     return fp
+
+
+def _tags(v):
+    """A boundary entry as the fingerprint holds it: a tag, a gmsh physical name, or a sorted
+    list of them (numbers as numbers, names as names)."""
+    if isinstance(v, (int, np.integer, str)):
+        return v if isinstance(v, str) else int(v)
+    if all(not isinstance(x, str) for x in v):
+        return sorted(map(int, v))
+    return sorted(map(str, v))

@@ -33,6 +33,8 @@ from damage_dolfinx.runtime.runner import Progress, solver_step
 from damage_dolfinx.studies.convergence_tables import (fitted_rates, plot_convergence,  # noqa: F401
                                                       write_tables)
 from damage_dolfinx.numerics.solvers import ConvergenceError
+from damage_dolfinx.studies.point_transfer import (COMPARISON, NESTED_COMPARISON, OUTSIDE_TOLERANCE,
+                                                   PointValues, ReferencePoints)
 
 SCHEMA = "damage-dolfinx/convergence/v1"
 
@@ -64,16 +66,16 @@ class _CoarseRun:
         self.ref_rank, self.world, self.outbox = ref_rank, world, outbox
         self.components = []
         if ref is None:  # a rank without the reference: the coarse halves of its own cells
-            self._send = [post.nested_transfer(f.function_space, None, grid)
-                          for _, f, _ in self.stepper.error_components] if self.mine else []
+            self._send = [transfers.coarse(f.function_space, grid, i)
+                          for i, (_, f, _) in enumerate(self.stepper.error_components)] \
+                if self.mine else []
             return
         coarse = dict((name, f) for name, f, _ in self.stepper.error_components) \
             if self.mine else {}
-        for name, f_ref, _ in ref.error_components:
-            fine_side = transfers(grid, f_ref.function_space)
+        for i, (name, f_ref, _) in enumerate(ref.error_components):
+            fine_side = transfers(grid, f_ref.function_space, i)
             f = coarse.get(name)
-            coarse_side = post.nested_transfer(f.function_space, None, grid) \
-                if f is not None else None
+            coarse_side = transfers.coarse(f.function_space, grid, i) if f is not None else None
             self.components.append((name, fine_side, coarse_side, f,
                                     fem.Function(f_ref.function_space)))
         self.err_parts = {name: 0.0 for name, *_ in self.components}
@@ -160,6 +162,89 @@ def _cell_geometry(runs, comm):
     return out
 
 
+class _Transfers:
+    """The coarse-to-fine transfers of a study: exact nested transfer (post.nested_transfer)
+    when every mesh of the family is a nested structured grid of the reference's, point
+    evaluation (point_transfer.py) otherwise. Collective on the study's ranks."""
+
+    def __init__(self, ref, ref_n, ns, geometry, comm):
+        ref_grid = comm.bcast(ref.data.geometry.grid if comm.rank == 0 else None, root=0)
+        grids = [grid for grid, _ in geometry.values()]
+        self.nested = ref_grid is not None and all(
+            g is not None and ref_grid.nx % g.nx == 0 and ref_grid.ny % g.ny == 0
+            for g in grids)
+        structured = ref_grid is not None and all(g is not None for g in grids)
+        if structured and not self.nested:  # a structured family keeps today's nested path
+            bad = next(n for n in ns if ref_n % n)
+            raise InputError(f"coarse mesh n = {bad} is not nested in the reference "
+                             f"n = {ref_n}")
+        self.comparison = NESTED_COMPARISON if self.nested else COMPARISON
+        self.points, self.fine, self.coarse_sides = None, {}, []
+        if not self.nested:  # the reference's dof points, every component, on every rank
+            parts = [ReferencePoints(f.function_space) for _, f, _ in ref.error_components] \
+                if ref is not None else None
+            if ref is not None:
+                self.fine = {i: p for i, p in enumerate(parts)}
+            self.points = comm.bcast([p.points for p in parts] if comm.rank == 0 else None,
+                                     root=0)
+
+    def __call__(self, grid, V_fine, i):
+        """The fine half for component ``i`` (shared by the cells of one grid)."""
+        if not self.nested:
+            return self.fine[i]
+        key = (grid.nx, grid.ny, id(V_fine))
+        if key not in self.fine:
+            self.fine[key] = post.nested_transfer(None, V_fine, grid)
+        return self.fine[key]
+
+    def coarse(self, V_coarse, grid, i):
+        if self.nested:
+            return post.nested_transfer(V_coarse, None, grid)
+        side = PointValues(V_coarse, self.points[i])
+        self.coarse_sides.append((V_coarse.mesh, side))
+        return side
+
+    def check_coverage(self, runs, comm):
+        """Refuse a family whose coarse meshes leave reference points farther than
+        OUTSIDE_TOLERANCE h outside (before any step)."""
+        if self.nested:
+            return
+        worst = 0.0, None
+        for run in runs:
+            for msh, side in self.coarse_sides:
+                if run.mine and msh is run.stepper.mesh and side.outside > worst[0]:
+                    worst = side.outside / run.h, (run.n, side.outside, run.h)
+        found = comm.allgather(worst)
+        ratio, detail = max(found, key=lambda w: w[0])
+        if ratio > OUTSIDE_TOLERANCE:
+            n, distance, h = detail
+            raise InputError(f"the meshes of this family cannot be compared: reference points lie "
+                             f"{distance:.3g} outside the coarse mesh n = {n} (h = {h:.3g}); "
+                             "its meshes must cover the same domain")
+
+
+def _norm_statement(components) -> str:
+    """The norm of the errors, in words."""
+    words = {"V": "||eps(.)||_L2 (the V norm)", "L2": "the L2 norm"}
+    return ", ".join(f"{name}: {words[norm]}" for name, _, norm in components)
+
+
+def _check_states(ref, runs, comm, when):
+    """Stop the study (ConvergenceError on every rank) when the reference or a cell holds a
+    NaN/inf or a zeta outside [zeta*, 1] (guards.state_problem; one allreduce)."""
+    from damage_dolfinx.runtime.guards import state_problem
+    detail = None
+    for name, stepper in [("the reference", ref)] + [
+            (f"the cell n = {r.n}, k = {r.k:g}", r.stepper) for r in runs if r.mine]:
+        if stepper is not None and detail is None:
+            code, text = state_problem(stepper)
+            detail = f"{name} at {when}: {text}" if code else None
+    if comm.allreduce(1 if detail else 0, op=MPI.MAX):
+        detail = next(d for d in comm.allgather(detail) if d)
+        raise ConvergenceError(f"{detail}; the study is stopped (the model or its data gave "
+                               "numbers that cannot be right)")
+
+
 def _component_norms(ref):
     """{name: ComponentNorm} of the reference stepper's ``error_components``."""
     return {name: post.ComponentNorm(f, norm) for name, f, norm in ref.error_components}
@@ -184,11 +269,16 @@ def _check_levels(ref_n, ref_k, ns, ks):
                              f"{' '.join(f'{v:g}' for v in values)}")
 
 
-def _check_nested(ref_n, ref_k, ns, ks):
-    _check_levels(ref_n, ref_k, ns, ks)
+def _structured(ex, n) -> bool:
+    """Whether the family's mesh at level n is a structured grid (built on each rank alone: a
+    coarse mesh, before any run)."""
+    return ex.make_geometry(MPI.COMM_SELF, n, None).grid is not None
+
+
+def _check_steps(ref_n, ref_k, ns, ks):
+    """Coarse levels below the reference's, coarse steps multiples of its step (the nesting of
+    the meshes is checked once they are built: _Transfers)."""
     for n in ns:
-        if ref_n % n:
-            raise InputError(f"coarse mesh n = {n} is not nested in the reference n = {ref_n}")
         if n >= ref_n:
             raise InputError(f"coarse mesh n = {n} must be coarser than the reference n = {ref_n}")
     for k in ks:
@@ -225,14 +315,20 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
         overrides.setdefault("stability_check", ex.params.extra.get("stability_check", "warn"))
     defaults = ex.convergence or {}
     if ex.n is None:
-        raise InputError(f"example {example_id} has no nested structured meshes; "
-                         "convergence studies need one (e.g. 2.1-ex1)")
+        raise InputError(f"example {example_id} has no mesh family; convergence studies need "
+                         "one: meshes (comm, n) -> mesh at levels n (e.g. 2.1-ex1)")
     ref_n = defaults["ref_n"] if ref_n is None else ref_n  # 0 is refused, not the default
     ref_k = defaults["ref_k"] if ref_k is None else ref_k
     ns = list(defaults["n"] if ns is None else ns)
     ks = list(defaults["k"] if ks is None else ks)
     T = ex.T if T is None else T
-    _check_nested(ref_n, ref_k, ns, ks)
+    _check_levels(ref_n, ref_k, ns, ks)
+    _check_steps(ref_n, ref_k, ns, ks)
+    if not ex.own or _structured(ex, min(ns)):  # nested structured: every n divides ref_n
+        for n in ns:
+            if ref_n % n:
+                raise InputError(f"coarse mesh n = {n} is not nested in the reference "
+                                 f"n = {ref_n}")
     for n in ns + [ref_n]:
         ex.configure(n=n, k=ref_k, T=T, overrides=overrides)
     for k in ks:
@@ -324,18 +420,12 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
                 stepper = ex.build(MPI.COMM_SELF, n=n, k=k, T=T, overrides=overrides)
             runs.append(_CoarseRun(n, k, int(round(k / ref_k)), owner, stepper))
     geometry = _cell_geometry(runs, comm)
-    fine_sides = {}
-
-    def transfers(grid, V_fine):  # the fine half of a transfer, shared by the cells of one n
-        key = (grid.nx, grid.ny, id(V_fine))
-        if key not in fine_sides:
-            fine_sides[key] = post.nested_transfer(None, V_fine, grid)
-        return fine_sides[key]
-
+    transfers = _Transfers(ref, ref_n, ns, geometry, comm)
     outbox = []
     for run in runs:
         run.connect(ref, *geometry[(run.n, run.k)], transfers, norms, ref_comm, ref_rank, comm,
                     outbox)
+    transfers.check_coverage(runs, comm)  # a family that cannot be compared: refused now
     claim()
     num_steps = comm.bcast(ref.num_steps if comm.rank == 0 else None, root=0)
     report = Progress(f"{ex.id} converge", num_steps, comm, enabled=progress, interval=10.0)
@@ -346,6 +436,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
     for run in runs:
         if run.mine:
             run.advance(initial=True)
+    _check_states(ref, runs, comm, "t = 0")
     for run in runs:
         run.measure()
     step, measure_wall = 0, 0.0
@@ -362,6 +453,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
         for run in due:
             if run.owner is None:
                 run.advance()
+        _check_states(ref, due, comm, f"step {step} of the reference")
         start = time.perf_counter()
         for run in due:
             run.measure()
@@ -395,7 +487,8 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
     summary = {"schema": SCHEMA, "status": "completed", **settings, "example": ex.id,
                "title": ex.title,
                "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k, "T": T, "n": ns, "k": ks,
-               "error_definition": definition,
+               "error_definition": definition, "norm": _norm_statement(components),
+               "comparison": transfers.comparison,
                "errors": rows, "rates": rates, "rates_at_T": rates_T,
                **({"rates_note": "a rate without a value (null) needs two or more levels that "
                                  "differ in it"}
@@ -418,7 +511,8 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
             write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
             label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
             plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k,
-                             definition)
+                             definition, title=f"{ex.id} (model {ex.model_id})" if ex.own
+                             else f"{label}: {ex.title}")
     io.collective(comm, out, "the tables and convergence.png", tables)  # OutputError: exit 4
     if comm.rank == 0:
         if progress:  # progress=False prints nothing

@@ -54,24 +54,72 @@ def write_tables(out, rows, ns, ks, rates, rates_T, example_id, ref_n, ref_k, de
     (out / "errors.md").write_text("\n".join(lines))
 
 
-def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="error"):
+#: a journal column (88 mm) and the height of the plot
+COLUMN_WIDTH_IN, PLOT_HEIGHT_IN = 3.46, 2.9
+
+
+def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="error",
+                     title=None):
+    """log-log error against h + k for a journal column: one line per time step, a tick and a
+    label at every level (h + k of every cell), the axes named with their quantities and the
+    error's norms, the fitted slope of all cells drawn (dashed, with its value), the slope in h
+    at the smallest k dotted, and a title naming the problem and the norm."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
     from damage_dolfinx.viz import figstyle
-    fig, ax = figstyle.plt().subplots(figsize=(6.4, 4.6))
+    pyplot = figstyle.plt()
+    fig, ax = pyplot.subplots(figsize=(COLUMN_WIDTH_IN, PLOT_HEIGHT_IN))
     ks = sorted({r["k"] for r in rows}, reverse=True)
     for k in ks:
         sel = sorted((r for r in rows if r["k"] == k), key=lambda r: r["h_plus_k"])
-        ax.loglog([r["h_plus_k"] for r in sel], [r["error"] for r in sel], "o-", ms=4,
+        ax.loglog([r["h_plus_k"] for r in sel], [r["error"] for r in sel], "o-", ms=3.5, lw=1,
                   label=f"$k$ = {k:g}")
     hk = np.array([r["h_plus_k"] for r in rows])
     err = np.array([r["error"] for r in rows])
     p = rates["h_plus_k_all"]
-    c = np.exp(np.mean(np.log(err) - p * np.log(hk)))
-    xs = np.array([hk.min(), hk.max()])
-    ax.loglog(xs, c * xs**p, "k--", label=f"fit: rate {p:.2f}")
-    ax.set_xlabel("$h + k$")
-    ax.set_ylabel(figstyle.error_mathtext(definition))
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
+    if np.isfinite(p):
+        c = np.exp(np.mean(np.log(err) - p * np.log(hk)))
+        xs = np.array([hk.min(), hk.max()])
+        ax.loglog(xs, c * xs**p, "k--", lw=1, label=f"fit, all cells: slope {p:.2f}")
+    col = sorted((r for r in rows if r["k"] == min(ks)), key=lambda r: r["h_plus_k"])
+    q = rates.get("h_at_smallest_k", float("nan"))
+    if len(col) > 1 and np.isfinite(q):
+        x = np.array([r["h_plus_k"] for r in col])
+        e = np.array([r["error"] for r in col])
+        c = np.exp(np.mean(np.log(e) - q * np.log(x)))
+        ax.loglog(x, 0.7 * c * x**q, ":", color="0.35", lw=1.2,
+                  label=f"slope in $h$ at $k$ = {min(ks):g}: {q:.2f}")
+    levels = np.unique(np.round(hk, 12))
+    ax.xaxis.set_major_locator(FixedLocator(levels))
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xticks(levels)
+    labels, last = [], None
+    for v in levels:  # a tick at every level; a label where it does not overlap the previous
+        show = last is None or np.log10(v / last) > 0.07
+        labels.append(f"{v:.3g}" if show else "")
+        last = v if show else last
+    ax.set_xticklabels(labels, rotation=60, fontsize=7)
+    ax.set_xlabel("mesh size + time step, $h + k$ (length + time units)", fontsize=8)
+    norms = figstyle.error_mathtext(definition)
+    ax.set_ylabel(f"error {norms}", fontsize=8)
+    ax.tick_params(axis="y", labelsize=7)
+    ax.grid(True, which="major", alpha=0.3)
+    ax.legend(fontsize=6, loc="lower right", framealpha=0.85)
     figstyle.log_tick_labels(ax)
-    figstyle.save(fig, path, title=f"{example_id}: convergence (reference $n$ = {ref_n}, "
-                  f"$k$ = {ref_k:g})")
+    from matplotlib.ticker import FixedFormatter
+    ax.xaxis.set_major_locator(FixedLocator(levels))
+    ax.xaxis.set_major_formatter(FixedFormatter(labels))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    lo, hi = ax.get_ylim()
+    if hi / lo < 10:  # less than a decade: a label at every tick of the error axis
+        from matplotlib.ticker import FuncFormatter, LogLocator
+        ax.yaxis.set_minor_locator(LogLocator(subs=np.arange(1, 10)))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+        ax.tick_params(axis="y", which="minor", labelsize=7)
+    name = title or example_id
+    fig.tight_layout()
+    ax.set_title(f"{name}\nconvergence in {norms}\nreference $n$ = {ref_n}, $k$ = {ref_k:g}",
+                 fontsize=7.5)
+    fig.savefig(path, dpi=300, bbox_inches="tight")
+    pyplot.close(fig)
