@@ -1,17 +1,22 @@
 """Helpers shared by the benchmark scripts (each script puts this folder on ``sys.path`` and
-imports it): the checkout's folders, the fastest-of-blocks timing and the per-problem record of
+imports it; importing it puts the checkout on ``sys.path`` too, so that the scripts import the
+checkout's ``reproduction`` package, which is not installed with the library): the checkout's folders, the fastest-of-blocks timing and the per-problem record of
 the step profiles (performance/step_floor.py), and the field comparison of the platform checks
 (platforms/cross_version.py, platforms/ranks_check.py)."""
 import json
 import os
 import subprocess
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
 BENCHMARKS = Path(__file__).resolve().parent
+#: the checkout: the folder holding benchmarks/, reproduction/ and damage_dolfinx/
 REPO = BENCHMARKS.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
 #: the committed records, one folder per topic (benchmarks/README.md names each)
 RECORDS = BENCHMARKS / "reference_output"
 #: the thesis error tables (transcribed from the thesis; Tables 2.1 and 3.3 withheld)

@@ -149,9 +149,16 @@ def _sweep(args):
         if name in grid:
             raise InputError(f"--set {name}: the parameter is given twice")
         grid[name] = parse_values(values, name) if values else []
-    sweep(args.id, args.out, grid, n=args.n, k=args.k, T=args.T, restart=args.restart,
-          max_points=args.max_points, plot=args.plot, figures=not args.no_figures,
-          progress=not args.quiet)
+    summary = sweep(args.id, args.out, grid, n=args.n, k=args.k, T=args.T,
+                    restart=args.restart, max_points=args.max_points, plot=args.plot,
+                    figures=not args.no_figures, progress=not args.quiet)
+    if summary.get("status") == "failed":  # a point failed: the sweep did not succeed
+        first = summary["failed"][0]
+        why = summary.get("errors", {}).get(str(first)) or "see its summary.json"
+        if MPI.COMM_WORLD.rank == 0:
+            print(f"damage-dolfinx: failed: {len(summary['failed'])} of {summary['points']} "
+                  f"points failed (point_{first}: {why})", file=sys.stderr, flush=True)
+        return 3
     return 0
 
 
@@ -307,81 +314,126 @@ def _check_finite(args):
                 raise InputError(f"--{name.replace('_', '-')} must be a finite number, got {v}")
 
 
-def main(argv=None):
-    comm = MPI.COMM_WORLD
+def _load_plugins():
+    """Import the modules named in DAMAGE_DOLFINX_PLUGINS (comma-separated): they may register
+    models (damage_dolfinx.register_model), friction solvers or case sources before the run."""
+    import importlib
     from damage_dolfinx.parameters import InputError
-    from damage_dolfinx.numerics.solvers import ConvergenceError
-    from damage_dolfinx.runtime.io import OutputError
-    from damage_dolfinx.runtime.runner import RunInterrupted
+    for name in filter(None, (n.strip() for n in os.environ.get("DAMAGE_DOLFINX_PLUGINS",
+                                                                  "").split(","))):
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            raise InputError(f"DAMAGE_DOLFINX_PLUGINS names {name!r}, which cannot be "
+                             f"imported: {exc}") from None
+
+
+def main(argv=None):
+    """The command; every rank returns the same exit status (runtime/collective.py: an
+    exception on one rank only becomes one decided outcome, or ends the job)."""
+    import signal
+    from damage_dolfinx.runtime.signals import stop_outside_runs
+    comm = MPI.COMM_WORLD
     given = {}
+    before = {}
     try:
-        parser = _parser()
-        args, extra = parser.parse_known_args(argv)
-        given = _petsc_options(extra, parser, args.command)
-        _check_finite(args)
-        _check_petsc_values(given)
-        if args.command == "list":
-            from damage_dolfinx.catalogue import examples
-            if comm.rank == 0:
-                for ex in examples.catalogue().values():
-                    reading = f" (reading: {ex.reading})" if ex.readings else ""
-                    print(f"{ex.id:10s} [Section {ex.section}] {ex.title}{reading}")
-            return 0
-        if args.command == "run":
-            from damage_dolfinx.runtime import runner
-            runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
-                       overrides=_overrides(args.set, args.friction_solver, args.friction_law,
-                                                 args.reading, args),
-                       mesh_file=args.mesh,
-                       write_every=args.write_every, progress=not args.quiet,
-                       figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
-                       checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
-                       overwrite=args.overwrite, history_every=args.history_every)
-        elif args.command == "sweep":
-            _sweep(args)
-        elif args.command == "converge":
-            from damage_dolfinx.studies import convergence
-            convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
-                              ns=args.n, ks=args.k, T=args.T,
-                              overrides=_overrides(args.set, args.friction_solver,
-                                                   args.friction_law, args.reading, args),
-                              progress=not args.quiet,
-                              reference_ranks={"1": 1, "all": "all", None: None}[
-                                  args.reference_ranks],
-                              restart=args.restart, overwrite=args.overwrite)
-        unused = _unused(given, comm)
-        if unused and comm.rank == 0:
-            print(f"damage-dolfinx: warning: no solver of this {args.command} read the PETSc "
-                  f"option(s) {' '.join(unused)}: they had no effect", file=sys.stderr,
-                  flush=True)
-        return 0
-    except InputError as exc:
-        if comm.rank == 0:
-            print(f"damage-dolfinx: error: {exc}", file=sys.stderr, flush=True)
-        return 2
-    except ConvergenceError as exc:
-        if comm.rank == 0:
-            print(f"damage-dolfinx: solver failure: {exc}", file=sys.stderr, flush=True)
-        return 3
+        for s in (signal.SIGTERM, signal.SIGINT):  # the run's loop has its own (StopSignals)
+            before[s] = signal.signal(s, stop_outside_runs)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        return _main(argv, comm, given)
+    finally:
+        for s, handler in before.items():
+            if signal.getsignal(s) is stop_outside_runs:  # (an interruption leaves SIG_IGN)
+                signal.signal(s, handler)
+
+
+def _main(argv, comm, given):
+    from damage_dolfinx.runtime import collective
+    from damage_dolfinx.runtime.io import OutputError
+    from damage_dolfinx.runtime.signals import RunInterrupted
+    try:
+        with collective.outcome(comm):
+            try:
+                return _command(argv, comm, given)
+            finally:
+                _forget(given)
     except OutputError as exc:
-        if comm.rank == 0:
-            print(f"damage-dolfinx: output error: {exc}", file=sys.stderr, flush=True)
+        _say(comm, collective.line(exc))
         from damage_dolfinx.runtime.io import FAILED_HDF5_FILES
         if FAILED_HDF5_FILES:  # HDF5 would crash shutting down the failed file
             sys.stdout.flush()
             comm.Barrier()
             os._exit(4)
         return 4
-    except RunInterrupted as exc:
+    except (RunInterrupted, KeyboardInterrupt, collective.RankFailure) as exc:
         import signal
-        from damage_dolfinx.runtime.runner import STOP_SIGNALS
-        for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out
-            signal.signal(s, signal.SIG_IGN)
+        from damage_dolfinx.runtime.signals import STOP_SIGNALS
+        if not isinstance(exc, collective.RankFailure) or exc.kind == "":
+            for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out
+                signal.signal(s, signal.SIG_IGN)
+        _say(comm, collective.line(exc))
+        return collective.classify(exc)[0]
+    except Exception as exc:  # noqa: BLE001 - input, solver, user code: one line, its status
+        _say(comm, collective.line(exc))
+        return collective.classify(exc)[0]
+
+
+def _say(comm, text):
+    if comm.rank == 0:
+        from damage_dolfinx.errors import for_command_line
+        print(for_command_line(text), file=sys.stderr, flush=True)
+
+
+def _command(argv, comm, given):
+    """Parse and run the command; returns 0 (exceptions: main)."""
+    parser = _parser()
+    args, extra = parser.parse_known_args(argv)
+    given.update(_petsc_options(extra, parser, args.command))
+    _check_finite(args)
+    _check_petsc_values(given)
+    _load_plugins()
+    if args.command != "list":
+        from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
+        import_gmsh_keeping_sigint()
+    from damage_dolfinx.catalogue import examples  # the catalogue's ids (runtime/cases.py)
+    if args.command == "list":
         if comm.rank == 0:
-            print(f"damage-dolfinx: {exc}", file=sys.stderr, flush=True)
-        return exc.exit_status
-    finally:
-        _forget(given)
+            for ex in examples.catalogue().values():
+                reading = f" (reading: {ex.reading})" if ex.readings else ""
+                print(f"{ex.id:10s} [Section {ex.section}] {ex.title}{reading}")
+        return 0
+    if args.command == "run":
+        from damage_dolfinx.runtime import runner
+        runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
+                   overrides=_overrides(args.set, args.friction_solver, args.friction_law,
+                                        args.reading, args),
+                   mesh_file=args.mesh,
+                   write_every=args.write_every, progress=not args.quiet,
+                   figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
+                   checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
+                   overwrite=args.overwrite, history_every=args.history_every)
+    elif args.command == "sweep":
+        status = _sweep(args)
+        if status:
+            return status
+    elif args.command == "converge":
+        from damage_dolfinx.studies import convergence
+        convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
+                          ns=args.n, ks=args.k, T=args.T,
+                          overrides=_overrides(args.set, args.friction_solver,
+                                               args.friction_law, args.reading, args),
+                          progress=not args.quiet,
+                          reference_ranks={"1": 1, "all": "all", None: None}[
+                              args.reference_ranks],
+                          restart=args.restart, overwrite=args.overwrite)
+    unused = _unused(given, comm)
+    if unused and comm.rank == 0:
+        print(f"damage-dolfinx: warning: no solver of this {args.command} read the PETSc "
+              f"option(s) {' '.join(unused)}: they had no effect", file=sys.stderr,
+              flush=True)
+    return 0
 
 
 if __name__ == "__main__":

@@ -162,6 +162,9 @@ class TimeGrid:
         if not (self.T > 0):
             raise InputError(f"final time T must be positive, got T = {self.T}")
         ratio = self.T / self.k
+        if round(ratio) < 1:  # the tolerance below would let any T < 1e-8 k through
+            raise InputError(f"final time T = {self.T:g} is below the time step k = {self.k:g}: "
+                             "the run would take no step")
         if abs(ratio - round(ratio)) > 1e-8 * max(1.0, ratio):
             raise InputError(f"time step k = {self.k} does not divide T = {self.T} (T/k = {ratio:.6g})")
 

@@ -36,23 +36,21 @@ class Problem:
     """One of the models on your mesh, with your data.
 
     Attributes:
-        model: the model id, a key of :data:`damage_dolfinx.MODELS` (``"2.1"`` elastic,
-            ``"2.2"`` Kelvin-Voigt with Tresca friction, ``"2.3"`` long memory, ``"2.4"``
-            viscoplastic, ``"3.1"`` dynamic with normal compliance, ``"3.2"`` dynamic with
-            Tresca friction, ``"3.3"`` fully damageable dynamic).
+        model: a model id, a key of :data:`damage_dolfinx.MODELS` (which lists them with
+            their titles), or a :class:`~damage_dolfinx.Model` class, e.g. one of your own.
         mesh: a :class:`~damage_dolfinx.geometries.Geometry`, a ``(mesh, facet_tags)`` pair, the
             path of a gmsh ``.msh`` file, or a function ``(comm, n)`` returning one of these (a
             mesh family: the only form :func:`~damage_dolfinx.converge` can refine).
         T: final time.
-        k: time step (None: the largest below 0.8 k_max and T/100 that divides T; for the
-            dynamic models k must be given). A k above the scheme's stability limit k_max is
-            refused unless ``allow_unstable``.
-        boundaries: ``{role: tag or [tags]}``; roles ``clamped`` (u = 0), ``traction``
-            (the traction acts there), and the model's contact role: ``bilateral`` (2.1,
-            u.nu = 0), ``tresca`` (2.2, 2.4 P1, 3.2: bilateral contact, Tresca friction bound
-            ``g_fric``), ``coulomb`` (2.4 P2: simplified Coulomb, normal stress ``S_n``, bound
-            ``mu_f |S_n|``), ``normal_compliance`` (2.3, 3.1, 3.3: stiffness ``c_nu``, gap
-            ``gap``). Every tag named must be present on the mesh and non-empty. None: the
+        k: time step (None: the largest below 0.8 k_max and T/100 that divides T; for a
+            dynamic model k must be given). A k above the scheme's stability limit k_max is
+            refused unless ``allow_unstable``; :meth:`k_max` gives the limit before the run.
+        boundaries: ``{role: tag or [tags]}``, a tag a number or a gmsh physical name
+            (``{"clamped": "left"}``, a mesh read from gmsh); roles ``clamped`` (u = 0), ``traction``
+            (the traction acts there), and one of the model's ``contact_roles``: ``bilateral``
+            (u.nu = 0), ``tresca`` (bilateral contact, Tresca friction bound ``g_fric``),
+            ``coulomb`` (simplified Coulomb, normal stress ``S_n``, bound ``mu_f |S_n|``),
+            ``normal_compliance`` (stiffness ``c_nu``, gap ``gap``). Every tag named must be present on the mesh and non-empty. None: the
             mesh's tags are used as they are (1 clamped, 2 traction, 3 contact).
         params: a :class:`~damage_dolfinx.ModelParameters`, or a dict of changes to the
             model's defaults (:func:`~damage_dolfinx.model_defaults`); unknown names are
@@ -88,14 +86,20 @@ class Problem:
     builders: dict = field(default_factory=dict)
     allow_unstable: bool = False
 
+    def k_max(self, comm=None) -> float:
+        """The time-step limit of the scheme's explicit terms for this mesh and data (inf: none);
+        a k above it is refused. Collective (runtime/limits.py)."""
+        from damage_dolfinx.runtime.limits import k_max
+        return k_max(self, comm) if comm is not None else k_max(self)
+
     def parameters(self) -> ModelParameters:
         """The run's data: the model's defaults with ``params`` applied (validated)."""
-        from damage_dolfinx.models.registry import default_parameters, model, validate
+        from damage_dolfinx.models.registry import model, validate
         info = model(self.model)
         if isinstance(self.params, ModelParameters):
             p = self.params
         else:
-            p = default_parameters(info.id)
+            p = info.defaults()
             changes = dict(self.params or {})
             known = {f.name for f in dataclasses.fields(p)} | set(p.extra)
             own = {key: changes.pop(key) for key in list(changes) if key not in known}
@@ -105,17 +109,17 @@ class Problem:
                     raise InputError(f"unknown parameter(s) {sorted(own)} of model {info.id} "
                                      "(own data are for a damage law, and none is given)")
                 p = dataclasses.replace(p, extra={**p.extra, **own})
-        roles = set(self.boundaries or {})
-        if info.id == "2.4" and roles & {"tresca", "coulomb"}:
-            p = p.replace(friction_law="coulomb" if "coulomb" in roles else "tresca")
-        return validate(info.id, p)
+        p = info.with_roles(p, set(self.boundaries or {}))
+        return validate(info, p)
 
     def example(self):
         """The run description the run machinery takes (internal)."""
-        from damage_dolfinx.catalogue.examples import Example, Figure
+        from damage_dolfinx.description import Example, Figure
         from damage_dolfinx.laws import DamageLaw
         from damage_dolfinx.meshes import as_geometry
-        from damage_dolfinx.models.registry import model, quasistatic_k_max
+        from damage_dolfinx.models.registry import model
+        from damage_dolfinx.validation import check_problem
+        self = check_problem(self)  # every argument, before any work (validation.py)
         info = model(self.model)
         if self.damage_law is not None and not isinstance(self.damage_law, DamageLaw):
             raise InputError("damage_law must be a damage_dolfinx.DamageLaw "
@@ -125,10 +129,10 @@ class Problem:
         params = self.parameters()
         k = self.k
         if k is None:
-            if info.id.startswith("3."):
-                raise InputError(f"model {info.id} needs a time step k (its limit k_max depends "
-                                 "on the mesh; a k above it is refused with its value)")
-            k = min(self.T / 100.0, 0.8 * quasistatic_k_max(info.id, params))
+            if info.dynamic:
+                raise InputError(f"model {info.id} needs a time step k below its limit k_max, "
+                                 "which depends on the mesh and data: problem.k_max() gives it")
+            k = min(self.T / 100.0, 0.8 * info.k_max(params))
             k = self.T / math.ceil(self.T / k * (1 - 1e-12))
         family = callable(self.mesh) and not isinstance(self.mesh, tuple)
         n = self.n if family else None
@@ -145,7 +149,7 @@ class Problem:
             f"thesis variant {params.variant}"
         return Example(
             id=self.name, title=f"{info.title} (own problem)", section=info.id, params=params,
-            T=float(self.T), k=float(k), make_geometry=make_geometry, model=info.id,
+            T=float(self.T), k=float(k), make_geometry=make_geometry, model=info,
             diameter=math.nan, n=n, dim=0, body_force=self.body_force, traction=self.traction,
             zeta0=self.zeta0, builders=dict(self.builders), damage_law=self.damage_law,
             irreversible=bool(self.irreversible), boundaries=self.boundaries, own=True,

@@ -14,16 +14,15 @@ from damage_dolfinx.numerics.constitutive import eps
 from damage_dolfinx.numerics.contact import normal_compliance_pressure
 
 from damage_dolfinx.forms.elastic_damage import load
-from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, viscous_stress
+from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, kelvin_voigt_stress, viscous_stress
 
 #: quadrature degree of the truncated (Phi_L) and positive-part (contact) terms (the thesis
 #: states none)
 NONLINEAR_DEGREE = 2
 
 
-def total_stress(v, u, zeta, E, nu, m_visc, L_trunc):
-    """sigma_n = A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (Sections 1.6, 1.9)."""
-    return viscous_stress(v, E, nu, m_visc) + damaged_elastic_stress(u, zeta, E, nu, L_trunc)
+#: sigma_n = A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (Sections 1.6, 1.9)
+total_stress = kelvin_voigt_stress
 
 
 def velocity_step_forms(v, w, v_old, u_old, zeta_old, rho, k, E, nu, m_visc, L_trunc, c_nu, gap,

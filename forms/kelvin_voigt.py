@@ -21,6 +21,11 @@ def damaged_elastic_stress(u, zeta, E, nu, L_trunc):
     return zeta * Phi_L(B(eps(u), E, nu), L_trunc)
 
 
+def kelvin_voigt_stress(v, u, zeta, E, nu, m_visc, L_trunc):
+    """sigma = A eps(v) + zeta Phi_L(B eps(u)) (Sections 1.6, 1.9): the Kelvin-Voigt stress."""
+    return viscous_stress(v, E, nu, m_visc) + damaged_elastic_stress(u, zeta, E, nu, L_trunc)
+
+
 def velocity_step_forms(v, w, u_old, zeta_old, E, nu, m_visc, L_trunc, f_B, f_N, dsN):
     """(a, l) of the velocity VI: a(v, w) = (A eps(v), eps(w)), l(w) = L_n(w) - elastic(w)."""
     a = ufl.inner(viscous_stress(v, E, nu, m_visc), eps(w)) * ufl.dx

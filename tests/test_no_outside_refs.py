@@ -82,11 +82,11 @@ def docstrings_and_comments(source):
 @pytest.mark.parametrize("scope", ["damage_dolfinx", "forms", "geometries"])
 def test_docstrings_and_comments_speak_in_words(scope):
     """No bare gap/reading code in a docstring or comment: the reader is pointed to the models
-    page or told in words. The report module that translates the codes may name them."""
+    page or told in words (the report, which translates the codes, lives outside the package)."""
     hits = []
     for path in tracked(scope):
         rel = path.relative_to(ROOT).as_posix()
-        if path.suffix != ".py" or rel.startswith("damage_dolfinx/report/"):
+        if path.suffix != ".py":
             continue
         for line, text in docstrings_and_comments(path.read_text(encoding="utf-8")):
             for match in CODE.finditer(text):

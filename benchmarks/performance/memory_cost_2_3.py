@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
+import damage_dolfinx.catalogue  # noqa: F401 (the catalogue's ids)
 from damage_dolfinx.runtime import runner
 
 parser = argparse.ArgumentParser()

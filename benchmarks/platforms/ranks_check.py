@@ -30,7 +30,7 @@ TOL = 1e-8
 
 
 def _options(ex, steps):
-    from damage_dolfinx.report.reproduce import _quick_options
+    from reproduction.reproduce import _quick_options
     opts = _quick_options(ex)
     k = float(opts[opts.index("--k") + 1]) if "--k" in opts else ex.k
     if "--T" in opts:

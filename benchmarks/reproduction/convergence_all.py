@@ -9,9 +9,12 @@ fitted rates) and summary.json (wall time of the reference run) into OUT/<id>[-v
 OUT/index.json lists commands, rates and wall times.
 """
 import argparse
+import sys
 from pathlib import Path
 
-from damage_dolfinx.report import reproduce
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+import common  # noqa: E402,F401  (puts the checkout on sys.path)
+from reproduction import reproduce  # noqa: E402
 
 p = argparse.ArgumentParser()
 p.add_argument("--quick", action="store_true", help="three coarse meshes, small reference")

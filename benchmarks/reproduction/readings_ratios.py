@@ -21,9 +21,12 @@ import csv
 import json
 from pathlib import Path
 
+import sys
+
 import numpy as np
 
-TABLES = Path(__file__).resolve().parents[1] / "thesis_tables.json"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+from common import RECORDS, THESIS_TABLES as TABLES  # noqa: E402
 
 
 def compare(table: dict, folder: Path, column: str = "error", exclude=()) -> dict:
@@ -59,7 +62,7 @@ STUDIES = {"2.4": ("2.2-ex2", []), "2.5": ("2.3-ex1", []), "2.6": ("2.4-ex1-tres
 
 
 def summary(tables: dict) -> str:
-    ref = Path(__file__).resolve().parents[1] / "reference_output"
+    ref = RECORDS
     lines = ["| thesis table | study | reading | ours / thesis per cell (min / median / max) | "
              "fitted rate thesis / ours |", "|---|---|---|---|---|"]
     for key, (folder, exclude) in STUDIES.items():

@@ -14,16 +14,20 @@ import argparse
 import re
 import shutil
 import subprocess
+import sys
 import tempfile
+from pathlib import Path
 
-from damage_dolfinx.report import build as report
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+import common  # noqa: E402,F401  (puts the checkout on sys.path)
+from reproduction import build as report  # noqa: E402
 
 p = argparse.ArgumentParser()
 p.add_argument("--results", default="results")
 p.add_argument("--pdf", action="store_true", help="also print REPORT.pdf with headless Chromium")
 a = p.parse_args()
 page = report.build(a.results)
-counts = re.search(r"\*\*(\d+ reproduced, .*?)\*\*", page.with_suffix(".md").read_text())
+counts = re.search(r"\*\*(of \d+ thesis .*?)\*\*", page.with_suffix(".md").read_text())
 print(f"report: {page.parent}/ (REPORT.html, REPORT.md, images/)"
       + (f": {counts.group(1)}" if counts else ""))
 chromium = shutil.which("chromium") or shutil.which("chromium-browser")

@@ -13,9 +13,12 @@ import argparse
 import json
 from pathlib import Path
 
+import sys
+
 import numpy as np
 
-REFERENCE = Path(__file__).resolve().parents[1] / "reference_output"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+from common import RECORDS as REFERENCE  # noqa: E402
 
 p = argparse.ArgumentParser()
 p.add_argument("--results", default="results", help="OUT of make convergence / make figures")

@@ -14,7 +14,10 @@ import json
 import sys
 from pathlib import Path
 
-REFERENCE = Path(__file__).resolve().parents[1] / "reference_output" / "wrench_3_3" / "wrench.json"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: common.py
+from common import RECORDS  # noqa: E402
+
+REFERENCE = RECORDS / "wrench_3_3" / "wrench.json"
 VALUES = ["max_penetration", "max_penetration_t", "penetration_at_T", "u_max_at_T",
           "zeta_min_at_T", "von_mises_max_at_T"]
 PLACES = ["max_penetration_at", "von_mises_argmax_at_T", "zeta_argmin_at_T"]

@@ -45,6 +45,7 @@ def parse():
 
 
 def run(args, comm):
+    import damage_dolfinx.catalogue  # noqa: F401 (the catalogue's ids)
     from damage_dolfinx.runtime import runner
     from damage_dolfinx.cli import _overrides
     return runner.run("2.1-ex3", Path(args.out) / "run", h=args.h, k=args.k, T=args.T,

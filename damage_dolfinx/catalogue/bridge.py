@@ -81,7 +81,7 @@ def examples():
             "(kN per metre) as a uniform downward traction P/|Gamma_N| on the extrados grid "
             "facets whose midpoints lie within +-0.05 m of the quarter-span abscissa "
             "x = -span/4 (a quarter of the clear span from the left springing)",
-            "CALIBRATED: load_rate = 4500 kN/s (4.5 kN per step at k = 0.001), T = 0.3 s: the "
+            "departure (fitted): load_rate = 4500 kN/s (4.5 kN per step at k = 0.001), T = 0.3 s: the "
             "smallest multiple of 250 kN/s whose failure load at h = 0.05, k = 0.001 reaches the "
             "thesis's 90 kN (damage model); it gives 94.5 kN (4250 kN/s: 89.25 kN). The "
             "agreement with 90 kN is therefore by construction, to one load increment. The "

@@ -8,14 +8,7 @@ from damage_dolfinx.catalogue.examples import Example, Figure, Reading
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx import ModelParameters
 
-#: Uzawa step (the thesis gives none) from log-spaced sweeps: at n = 16, k = 0.01 (all nodes slip)
-#: rho = 1, 10, 100 give 2 iterations per step (Newton solution to 2e-14), rho = 0.01 needs 25; at
-#: k = 0.02 (stick-slip) rho = 10 oscillates (no convergence), rho = 1 needs 17-31 and rho = 0.1
-#: 87-135 per step
-RHO_UZAWA = 1.0
-#: Bermudez-Moreno omega from the same sweep: omega = 100, 300, 1000 give 50, 31, 86 iterations
-#: per step and 4.6e-7, 2.5e-6, 1.0e-5 relative V-distance to Newton at tol 1e-6
-OMEGA_PD = 100.0
+from damage_dolfinx.blocks import OMEGA_PD, RHO_UZAWA  # noqa: F401 (section_2_4, 3_2)
 
 
 def _params(g_fric, solver="newton"):

@@ -19,7 +19,10 @@ def examples():
                    "memory_mode": "auto"})
 
     common = [
-        "G11: 'mu_nc = 1e10' read as c_nu = 1/mu_nc = 1e10 (near-rigid foundation)",
+        "departure (against the text): contact stiffness c_nu = 1e10 instead of the text's "
+        "1/mu = 1e-10: (2.145), line 2161, states p_nu(r) = r_+/mu with mu = 1e10; we use mu "
+        "as the stiffness (a near-rigid foundation), the text's p_nu is a foundation without "
+        "resistance",
         "G12: gap = 0", "G15: variant A, q_star = 1000",
         "G16: instantaneous elasticity B undamaged and untruncated",
         "memory by the left rectangle rule (2.136), g = zeta Phi_L(B eps(u)) stored in DG1 tensors",

@@ -42,7 +42,7 @@ EVIDENCE_EX1 = Reading(
     assumptions=[
         "R1 (evidence reading; chosen to match the thesis's results, against the text): c_nu = mu = 0.5e-4 (line 3328) used as the stiffness, "
         "p_nu(r) = mu r_+, instead of p_nu(r) = r_+/mu (2.145, line 2161; c_nu = 2e4): the "
-        "reading G11 already makes in Section 2.3 (mu = 1e10 there used as c_nu = 1e10). "
+        "reading Section 2.3 already makes (mu = 1e10 there used as c_nu = 1e10, against the text). "
         "With c_nu = 2e4 the explicit contact force is unstable for k above ~0.013 "
         "(stability.py), yet Table 3.1 reports smooth k = 0.05 and 0.02 columns; any c_nu "
         "below ~2.3e3 makes them stable. Against it: line 3374 (Example 2: no penetration "
@@ -110,7 +110,8 @@ def examples():
             "G25: zeta_0 = 0.1 + 0.9 min(1, max(0, |x_1 - 1.5| - 0.2)/1.3) (0.1 on (1.3,1.7)x(0,1), "
             "1 at x_1 = 0 and 3), nodal interpolation",
             "mesh 90 x 30 (--n 30 = cells per unit length), diagonals right",
-            "1.8: k = 0.004 (0.68 k_max) instead of the thesis' k = 0.01: k_max = 0.0059 "
+            "departure (against the text, for stability): k = 0.004 (0.68 k_max) instead of the "
+            "thesis' k = 0.01 (line 3374): k_max = 0.0059 "
             "(stability.py, n = 10 and 30), the explicit contact (c_nu = 2e4 on a body with "
             "E = 100) chatters at k = 0.01 (penetration 0 at t = 0.2 instead of 2.2e-4); "
             "--k 0.01 runs the thesis value (warning)",
@@ -136,7 +137,8 @@ def examples():
             "(underside of the overhang, gap 0), Gamma_N = [0,2]x{2}; other sides free; gmsh "
             "h = 1/32 (32 cells per unit length)",
             "G24: m_visc = 10; mu_nc = 0.5e-5 -> c_nu = 2e5",
-            "1.8: k = 0.001 (0.67 k_max) instead of the thesis' k = 0.01: k_max = 0.0015 for "
+            "departure (against the text, for stability): k = 0.001 (0.67 k_max) instead of the "
+            "thesis' k = 0.01 (line 3397): k_max = 0.0015 for "
             "h = 1/4 ... 1/32 (stability.py), set by the overhang bouncing on the foundation "
             "springs (rho = 0.05, c_nu = 2e5: omega^2 ~ c_nu/(rho H) ~ 4e6); at k = 0.01 the "
             "contact chatters and the overhang lifts off; --k 0.01 runs the thesis value (warning)",

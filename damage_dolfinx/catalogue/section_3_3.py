@@ -93,7 +93,7 @@ def examples():
             "lam_u = 2000, L_trunc = 1000, T = 1; no stop at zeta_star (G43)",
             "G10: structured n x n grid, diagonals right (nested meshes)",
             "error max_n ||u_n - u_n^hk||_L2 + ||zeta_n - zeta_n^hk||_L2 (Cor. 3.3, the thesis' "
-            "'L2 errors'); G36: the thesis table is x100 and its label garbled, compare trends",
+            "'L2 errors'); the thesis's table is not set beside ours",
             "1.8: with m_visc = 1 the explicit terms are harmless: k_max = 1.14 (n = 8), 0.73 "
             "(n = 128) from stability.py, far above the largest k = 0.1 of the table; the check "
             "is therefore off by default (it costs ~27 s per build at n = 128, and a convergence "
@@ -118,7 +118,8 @@ def examples():
         assumptions=common + [
             "thesis data: A = 1e-6 B (m_visc = 1e6), c_nu = 1e9, E = 7.1e9, nu = 0.33, "
             "rho = 2700, lam_u = 100, T = 7.5 as an upper bound",
-            "G32: L_trunc = inf (1000 would cap every stress component at 1000 Pa)",
+            "departure (against the text): L_trunc = inf instead of the L = 1000 of every Chapter 3 "
+            "example (line 2894); 1000 would cap every stress component at 1000 Pa",
             "G43: the run stops when min zeta reaches zeta_star (stop_at_zeta_star); the first "
             "time zeta(0,6) reaches zeta_star is summary.json probe_zeta_star_time",
             "initial damage (a) 0.1 on [2.5,3.5]^2 or (b) 0.1 on [2.5,3.5]x[0,1], 1 elsewhere, "
@@ -155,7 +156,8 @@ def examples():
         assumptions=common + [
             "thesis data: A = 1e-6 B (m_visc = 1e6), c_nu = 1e9, E = 7.1e9, nu = 0.33, "
             "rho = 2700, lam_u = 1.5e3, T = 6.5; no stop at zeta_star (G43)",
-            "G32: L_trunc = inf",
+            "departure (against the text): L_trunc = inf instead of the L = 1000 of every Chapter 3 "
+            "example (line 2894)",
             "G35: ring wrench: head disc R = 1.2 at the origin with a hexagonal hole (across "
             "flats 1.0, one flat facing the handle), handle x in [1, 10], width 0.8, loaded face "
             "= handle top for x in [9, 10], body rotated by -45 degrees (the traction "

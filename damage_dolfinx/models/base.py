@@ -1,6 +1,27 @@
-"""What every problem's time stepper shares: data, state, scalars for the history."""
+"""A model, the one unit that knows a scheme: :class:`Model` (the base every model derives from).
+
+A model class declares what the rest of the package reads from it, and nothing else is written
+about it anywhere:
+
+* ``id``, ``title``: its name in the registry and the records;
+* ``contact_roles``: what its contact boundary Gamma_C may mean (``tresca``, ...);
+* ``dynamic``: whether it has inertia (its k_max depends on the mesh: k must be given);
+* ``stability_limit``: what limits k (``""``: nothing), and :meth:`Model.k_max` for the
+  quasistatic schemes whose limit is closed-form;
+* :meth:`Model.defaults` (typed default data) and :meth:`Model.check` (their validation);
+* ``checkpoint_fields``: the attributes (Functions) that a checkpoint holds;
+* ``history_columns``: the scalars it adds to history.csv (every one must be written);
+* :meth:`Model.sub_steps`: its sub-steps, each a solver object with its kind and PETSc prefix;
+* in its constructor the unknowns (``self.u``, ``self.zeta``, ...) and ``self.output_fields``.
+
+One generic time loop (``runtime/runner.py``, or :func:`damage_dolfinx.steps`) runs any model:
+:meth:`Model.initialize` (t = 0), then :meth:`Model.advance` per step. A model implements
+``_advance()`` (t_{n-1} -> t_n, returning its solver counts) and ``update_output()``; its
+initial state is the shared one (zeta_0, u_0 = v_0 = 0) plus :meth:`Model.start`.
+"""
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Union
@@ -16,6 +37,10 @@ from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics.constitutive import eps
 from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
 from damage_dolfinx.numerics.solvers import SolveContext
+
+#: the damage data of the obstacle-inclusion models' defaults (variant A, (1.3))
+DAMAGE_A = dict(kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.1, lam_u=1000.0,
+                lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False)
 
 #: a load builder: (x = SpatialCoordinate, t = fem.Constant) -> UFL vector
 LoadBuilder = Callable[[object, object], object]
@@ -36,18 +61,94 @@ class ProblemData:
     irreversible: bool = False           # zeta_n <= zeta_{n-1} (the damage step's upper bound)
 
 
-class TimeStepper:
-    """Base of the schemes: holds the time level, the solve context and common scalars.
+@dataclass(frozen=True)
+class SubStep:
+    """One sub-step of a scheme: its name, the solver object (with ``solve()``), the kind of
+    solve (``linear``, ``snes-vi`` with bounds, ``newton`` on a regularised law, ``semismooth``
+    Newton, ``update`` for an explicit formula) and its PETSc options prefix."""
+    name: str
+    solver: object
+    kind: str
+    prefix: str = ""
 
-    Subclasses create ``self.u`` (displacement), ``self.zeta`` (damage) and ``self.von_mises``
-    (DG0), implement ``_initial_state()`` (t = 0), ``_advance()`` (one step t_{n-1} -> t_n,
-    returning a dict of iteration counts) and ``update_output()``, and list output fields in
-    ``self.output_fields``. Hooks for problem-specific output: ``extra_history_columns`` (keys
-    that ``scalars()`` or the step stats add to history.csv) and ``summary_extra()`` (keys added
+
+class Model:
+    """Base of the models: the time level, the solve context, the declarations and the common
+    scalars.
+
+    Subclasses create ``self.u`` (displacement), ``self.zeta`` and ``self.zeta_old`` (damage)
+    and ``self.von_mises`` (DG0), implement ``_advance()`` (one step t_{n-1} -> t_n, returning
+    a dict of iteration counts) and ``update_output()``, and list output fields in
+    ``self.output_fields``. Hooks for problem-specific output: ``history_columns`` (keys that
+    ``scalars()`` or the step stats add to history.csv; an instance may set
+    ``extra_history_columns`` when they depend on the data) and ``summary_extra()`` (keys added
     to summary.json).
     """
 
-    extra_history_columns: list = []
+    #: the model's id in the registry (None: an abstract base)
+    id: Optional[str] = None
+    title: str = ""
+    #: the contact roles its Gamma_C may play (boundary role names)
+    contact_roles: tuple = ()
+    #: boundary roles of its own beyond clamped, traction and contact: {role: facet tag the
+    #: model reads} (tags other than 1, 2, 3)
+    extra_roles: dict = {}
+    #: inertia: k must be given (the limit depends on the mesh)
+    dynamic: bool = False
+    #: what limits k ("" when nothing does)
+    stability_limit: str = ""
+    #: the Functions (attribute names) a checkpoint holds, in order
+    checkpoint_fields: tuple = ("u", "zeta")
+    #: the scalars this model adds to history.csv
+    history_columns: tuple = ()
+    #: the sub-steps in order: (attribute holding the solver, kind, PETSc options prefix)
+    scheme: tuple = ()
+    #: quadrature degree of the contact integrals (None: estimated from the integrand); the
+    #: contact resultant uses the scheme's, so that it balances the load exactly
+    contact_quadrature_degree: Optional[int] = None
+
+    # -- the declarations a run reads before building anything
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        """The model's default data (a generic starting point, docs/models.md)."""
+        raise NotImplementedError(f"model {cls.id} declares no default data")
+
+    @classmethod
+    def check(cls, params: ModelParameters) -> ModelParameters:
+        """The model's checks of its data (after ``params.validate()``); returns them."""
+        return params
+
+    @classmethod
+    def k_max(cls, params: ModelParameters) -> float:
+        """The closed-form stability limit of a quasistatic scheme with an explicit term
+        (inf: none, or mesh-dependent, checked when the model is built)."""
+        return math.inf
+
+    @classmethod
+    def boundary_roles(cls) -> dict:
+        """role -> the facet tag the model reads there: ``clamped`` 1 (Gamma_D), ``traction`` 2
+        (Gamma_N), each of ``contact_roles`` 3 (Gamma_C), and ``extra_roles``."""
+        from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+        return {"clamped": GAMMA_D, "traction": GAMMA_N,
+                **{role: GAMMA_C for role in cls.contact_roles}, **cls.extra_roles}
+
+    @classmethod
+    def with_roles(cls, params: ModelParameters, roles: set) -> ModelParameters:
+        """The data as the boundary roles named by a problem select them (default: as given)."""
+        return params
+
+    @property
+    def extra_history_columns(self) -> list:
+        return list(getattr(self, "_history_columns", None) or self.history_columns)
+
+    @extra_history_columns.setter
+    def extra_history_columns(self, columns):
+        self._history_columns = list(columns)
+
+    def sub_steps(self) -> list:
+        """The scheme's sub-steps in order (:class:`SubStep`), from ``scheme``."""
+        return [SubStep(name, getattr(self, name), kind, prefix)
+                for name, kind, prefix in self.scheme if getattr(self, name, None) is not None]
 
     def __init__(self, data: ProblemData):
         self.data, self.params = data, data.params
@@ -74,13 +175,9 @@ class TimeStepper:
     checkpoint_supported = True
 
     def checkpoint_state(self) -> dict:
-        """name -> Function: everything the next step reads (u, zeta, and v, sigma, ... where
-        the scheme has them). Steppers with more state extend this."""
-        state = {"u": self.u, "zeta": self.zeta}
-        for name in ("v", "w", "sigma"):
-            if isinstance(getattr(self, name, None), fem.Function):
-                state[name] = getattr(self, name)
-        return state
+        """name -> Function: everything the next step reads, as ``checkpoint_fields``
+        declares. Models with more state extend this."""
+        return {name: getattr(self, name) for name in self.checkpoint_fields}
 
     def restore(self, n: int):
         """Continue from time level n after checkpoint.load() has set checkpoint_state()."""
@@ -88,8 +185,20 @@ class TimeStepper:
 
     # -- time loop interface
     def initialize(self) -> dict:
+        """t = 0: zeta_0 (u_0 = v_0 = 0, the Functions' initial value), then :meth:`start`."""
         self._set_time(0)
-        return self._initial_state()
+        self.initial_damage()
+        self.zeta_old.x.array[:] = self.zeta.x.array
+        return self.start()
+
+    def initial_damage(self):
+        """zeta_0 into ``self.zeta`` (checked to lie in [zeta*, 1])."""
+        self.interpolate_zeta0(self.zeta)
+
+    def start(self) -> dict:
+        """What the scheme does at t = 0 after zeta_0 (e.g. the initial elastic solve); its
+        solver counts."""
+        return {}
 
     def advance(self) -> dict:
         self._set_time(self.n + 1)
@@ -201,6 +310,32 @@ class TimeStepper:
         m.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         return (*mats, m, m.sum(), mats[0].createVecLeft())
 
+    # -- contact
+    def contact_pressure(self):
+        """The normal contact pressure on Gamma_C as a UFL expression of the live Functions
+        (None: the model has no normal-compliance contact)."""
+        return None
+
+    def contact_resultant(self):
+        """int_{Gamma_C} p nu ds, the force of the foundation's pressure on the body, as a
+        NumPy vector on every rank (None without normal contact); forms compiled once."""
+        if not hasattr(self, "_resultant_forms"):
+            p = self.contact_pressure()
+            if p is None:
+                self._resultant_forms = None
+            else:
+                from damage_dolfinx.geometries import GAMMA_C
+                n = ufl.FacetNormal(self.mesh)
+                degree = self.contact_quadrature_degree
+                ds = ufl.Measure("ds", domain=self.mesh,
+                                 subdomain_data=self.data.geometry.facet_tags,
+                                 metadata={} if degree is None else {"quadrature_degree": degree})
+                self._resultant_forms = [compat.form(p * n[i] * ds(GAMMA_C))
+                                         for i in range(self.mesh.geometry.dim)]
+        if self._resultant_forms is None:
+            return None
+        return np.array([compat.assemble_scalar(f, self.comm) for f in self._resultant_forms])
+
     def iteration_totals(self) -> dict:
         return {}
 
@@ -218,3 +353,7 @@ class TimeStepper:
                 V = f.function_space
                 info[f"dofs_{name}"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
         return info
+
+
+#: the former name of :class:`Model`
+TimeStepper = Model

@@ -44,6 +44,7 @@ collapse the summary keeps D per (section, layer) and zeta on the unrolled intra
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Optional
 
@@ -55,7 +56,7 @@ from damage_dolfinx import compat
 from damage_dolfinx.numerics.constitutive import eps
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.geometries import GAMMA_N
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.parameters import InputError, ModelParameters
 from damage_dolfinx.models.base import ProblemData
 from damage_dolfinx.models.bridge_sections import RingSections
 from damage_dolfinx.models.elastic_2_1 import ElasticDamage
@@ -121,10 +122,23 @@ class _ClampedStep:
 class BridgeDamage(RingSections, ElasticDamage):
     """Problem VP^{hk} of Section 2.1 on the arch ring, with the collapse criterion."""
 
+    id = "2.1-collapse"
+    title = "quasistatic elastic masonry under a growing load, to collapse"
+    contact_roles = ()
     checkpoint_supported = False  # the failure record and hinge list are not saved
 
-    extra_history_columns = ["P_kN", "u_load_y", "weakest_section", "weakest_section_zeta_max",
-                             "n_hinges"]
+    history_columns = ("P_kN", "u_load_y", "weakest_section", "weakest_section_zeta_max",
+                       "n_hinges")
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return dataclasses.replace(ElasticDamage.defaults(), stop_at_zeta_star=False,
+                                   extra=dict(BRIDGE_DEFAULTS))
+
+    @classmethod
+    def check(cls, params: ModelParameters) -> ModelParameters:
+        check_bridge_parameters(params.extra)
+        return params
 
     def __init__(self, data: ProblemData, **kwargs):
         geo = data.geometry

@@ -41,7 +41,8 @@ from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.parameters import ModelParameters
 
 
 #: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
@@ -51,10 +52,24 @@ from damage_dolfinx.models.base import ProblemData, TimeStepper
 VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
 
 
-class DynamicKelvinVoigt(TimeStepper):
+class DynamicKelvinVoigt(Model):
     """Problem VP^{hk} of Section 3.1."""
 
-    extra_history_columns = ["v_L2", "u_max", "penetration_rms"]
+    id = "3.1"
+    title = "dynamic Kelvin-Voigt body, normal compliance"
+    contact_roles = ("normal_compliance",)
+    dynamic = True
+    stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
+    checkpoint_fields = ("u", "zeta", "v")
+    history_columns = ("v_L2", "u_max", "penetration_rms")
+    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # damage, (3.48)
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, q_star=1.0),
+                               extra={"rho": 1.0, "m_visc": 10.0, "c_nu": 1e4, "gap": 0.0,
+                                      "damage_active": True, "stability_check": "error",
+                                      "error_norm": "velocity"})
 
     def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
@@ -115,11 +130,6 @@ class DynamicKelvinVoigt(TimeStepper):
         self.timings = {"damage": 0.0, "velocity": 0.0, "stability": self.stability.get("time_s", 0.0)}
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)  # u_0 = v_0 = 0
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}
-
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array
         self.v_old.x.array[:] = self.v.x.array
@@ -180,6 +190,11 @@ class DynamicKelvinVoigt(TimeStepper):
         pen = compat.assemble_scalar(self._penetration, self.comm) if length > 0 else 0.0
         out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
         return out
+
+    def contact_pressure(self):
+        """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
+        from damage_dolfinx.numerics.contact import normal_compliance_pressure
+        return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations if self.damage else 0,

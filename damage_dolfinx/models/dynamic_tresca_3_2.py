@@ -33,16 +33,33 @@ from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_form
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import checked, estimate_stability
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.parameters import ModelParameters
 
 
-class DynamicTresca(TimeStepper):
+class DynamicTresca(Model):
     """Problem VP^{hk} of Section 3.2.
 
     Builders (ProblemData.builders): ``friction_bound`` (x -> UFL g(x), default the constant
     ``g_fric``) and ``contact_faces`` ({name: marker x -> bool}): for each face the history gets
     ``u_tau_max_<name>``, the largest |u_tau| over its contact nodes (nodal values).
     """
+
+    id = "3.2"
+    title = "dynamic Kelvin-Voigt body, bilateral contact with Tresca friction"
+    contact_roles = ("tresca",)
+    dynamic = True
+    stability_limit = "explicit elastic force (eigenvalue estimate)"
+    checkpoint_fields = ("u", "zeta", "v")
+    history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face
+    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, lam_D=0.0),
+                               extra={"rho": 1.0, "m_visc": 100.0, "g_fric": 5.0,
+                                      "stability_check": "error", **FRICTION_DEFAULTS})
 
     def __init__(self, data: ProblemData):
         super().__init__(data)
@@ -90,11 +107,6 @@ class DynamicTresca(TimeStepper):
         self.timings = {"damage": 0.0, "friction": 0.0}
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)  # u_0 = v_0 = 0
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}
-
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array
         self.v_old.x.array[:] = self.v.x.array

@@ -34,11 +34,25 @@ from damage_dolfinx.numerics.solvers import LinearSolver, lagged_direct
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import Model, ProblemData
+from damage_dolfinx.parameters import ModelParameters
 
 
-class ElasticDamage(TimeStepper):
+class ElasticDamage(Model):
     """Problem VP^{hk} of Section 2.1."""
+
+    id = "2.1"
+    title = "quasistatic elastic body with damage"
+    contact_roles = ("bilateral",)
+    #: u, zeta and the lagged preconditioner's damage (see checkpoint_state)
+    checkpoint_fields = ("u", "zeta", "zeta_pc")
+    scheme = (("damage", "linear", "damage_"), ("mech", "linear", "mech_"))   # (2.20), (2.21)
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.33, kappa=1.0, zeta_star=0.01, q_star=1000.0,
+                               variant="B", lam_D=0.1, lam_w=0.0, lam_u_plus=1000.0,
+                               lam_u_minus=100.0, stop_at_zeta_star=True)
 
     def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
@@ -86,10 +100,8 @@ class ElasticDamage(TimeStepper):
         self.output_fields = [self.u, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "mech": 0.0}  # seconds per sub-step, whole run
 
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        its = self._solve_mech()
+    def start(self) -> dict:
+        its = self._solve_mech()  # u_0 with zeta_0
         self.update_output()
         return {"mech_its": its}
 
@@ -115,7 +127,7 @@ class ElasticDamage(TimeStepper):
         """u, zeta and the lagged preconditioner's damage zeta_pc (with the flag _pc_due):
         without them a restart factorises at its first step and the resumed run differs at the
         CG tolerance (4e-13 serially, 1.1e-12 on 2 ranks after 10 restarts)."""
-        return {**super().checkpoint_state(), "zeta_pc": self.zeta_pc, "mech_pc_due": self._pc_due}
+        return {**super().checkpoint_state(), "mech_pc_due": self._pc_due}
 
     def restore(self, n: int):
         super().restore(n)

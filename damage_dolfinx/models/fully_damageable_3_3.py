@@ -47,11 +47,11 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.fully_damageable import (implicit_velocity_residual, total_stress,
                                       velocity_matrix_parts, velocity_rhs_boundary,
                                       velocity_step_forms)
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.parameters import InputError, ModelParameters
 from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
 from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
 from damage_dolfinx.numerics.zeta_linear import VelocitySolver
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
 
 #: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
 #: VELOCITY_EXTRAPOLATION);
@@ -70,8 +70,24 @@ FAST_RHS = True
 VELOCITY_EXTRAPOLATION = True
 
 
-class FullyDamageableContact(TimeStepper):
+class FullyDamageableContact(Model):
     """Problem VP^{hk} of Section 3.3."""
+
+    id = "3.3"
+    title = "dynamic fully damageable body, normal compliance"
+    contact_roles = ("normal_compliance",)
+    dynamic = True
+    stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
+    checkpoint_fields = ("u", "zeta", "v")
+    history_columns = ("v_L2",)  # + the contact monitor's and the probe's columns
+    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # (3.158), (3.159)
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, lam_D=0.0),
+                               extra={"rho": 1.0, "m_visc": 100.0, "c_nu": 1e4, "gap": 0.0,
+                                      "damage_active": True, "stability_check": "error",
+                                      "elastic_term": "explicit"})
 
     def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
@@ -162,9 +178,7 @@ class FullyDamageableContact(TimeStepper):
                         "stability": self.stability.get("time_s", 0.0)}
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self._interpolate_zeta0()  # u_0 = v_0 = 0
-        self.zeta_old.x.array[:] = self.zeta.x.array
+    def start(self) -> dict:
         self.profiles.sample(self.zeta, self.t)
         return {}
 
@@ -222,7 +236,7 @@ class FullyDamageableContact(TimeStepper):
         if self.probe.point is not None:
             self.probe(self.zeta, self.t, self.params.zeta_star)
 
-    def _interpolate_zeta0(self):
+    def initial_damage(self):
         """Example 2 selects its initial damage with ``--set initial_damage=a|b``."""
         choices = self.data.builders.get("zeta0")
         choice = self.params.extra.get("initial_damage")
@@ -300,6 +314,12 @@ class FullyDamageableContact(TimeStepper):
         out.update(self.probe.summary())
         out.update(self.profiles.summary(self.zeta, self.t))
         return out
+
+    def contact_pressure(self):
+        """eta_*(zeta_n) c_nu (u_n.nu - gap)_+ on Gamma_C (3.116)."""
+        from damage_dolfinx.forms.fully_damageable import damaged_contact_pressure
+        return damaged_contact_pressure(self.u, self.zeta, self.n_facet, self.c_nu, self.gap,
+                                        self.params.zeta_star)
 
     def iteration_totals(self) -> dict:
         out = {"damage_snes": self.damage.iterations if self.damage else 0}

@@ -29,13 +29,34 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
-from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, velocity_step_forms, viscous_stress
+from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.parameters import ModelParameters
 
 
-class KelvinVoigtTresca(TimeStepper):
+class KelvinVoigtTresca(Model):
     """Problem VP^{hk} of Section 2.2."""
+
+    id = "2.2"
+    title = "quasistatic Kelvin-Voigt body, bilateral contact with Tresca friction"
+    contact_roles = ("tresca",)
+    stability_limit = "explicit elastic term: k <= 2/m_visc"
+    checkpoint_fields = ("u", "zeta", "v")
+    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))  # (1), (2.67)
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=5000.0, nu=0.3, **DAMAGE_A,
+                               extra={"m_visc": 100.0, "g_fric": 5.0, **FRICTION_DEFAULTS})
+
+    @classmethod
+    def k_max(cls, params) -> float:
+        """The velocity step A eps(v_n) = -zeta Phi_L(B eps(u_{n-1})) + ..., A = B/m_visc with
+        the same boundary conditions, gives u_n = (1 - k m_visc zeta) u_{n-1} mode by mode:
+        stable iff k m_visc zeta <= 2, so k_max = 2/m_visc (zeta <= 1)."""
+        return 2.0 / float(params.extra["m_visc"])
 
     def __init__(self, data: ProblemData):
         super().__init__(data)
@@ -66,18 +87,12 @@ class KelvinVoigtTresca(TimeStepper):
 
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
-        sigma = (viscous_stress(self.v, p.E, p.nu, x["m_visc"])
-                 + damaged_elastic_stress(self.u, self.zeta, p.E, p.nu, p.L_trunc))
+        sigma = kelvin_voigt_stress(self.v, self.u, self.zeta, p.E, p.nu, x["m_visc"], p.L_trunc)
         self._vm_expr = compat.expression(von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "friction": 0.0}
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}
-
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array
         self.zeta_old.x.array[:] = self.zeta.x.array
@@ -112,7 +127,7 @@ class KelvinVoigtTresca(TimeStepper):
 
     def scalars(self) -> dict:
         out = super().scalars()
-        if not self.extra_history_columns:
+        if not hasattr(self, "_probe"):
             return out
         nodes, i, residual, r = self._probe  # R(w) = a(v, w) - l(w) = -sum_i m_i Phi_i w_tau,i
         with r.localForm() as rl:

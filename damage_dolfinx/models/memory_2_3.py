@@ -34,7 +34,8 @@ from damage_dolfinx.numerics.memory import MemoryKernel, MemoryTerm
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.parameters import ModelParameters
 
 
 #: Krylov iterations above which the lagged Jacobian factorisation is rebuilt
@@ -51,10 +52,22 @@ def mech_contact_amg():
     return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
 
 
-class ViscoelasticMemoryContact(TimeStepper):
+class ViscoelasticMemoryContact(Model):
     """Problem VP^{hk} of Section 2.3."""
 
-    extra_history_columns = ["penetration_rms", "stress_L2"]
+    id = "2.3"
+    title = "quasistatic viscoelastic body with long memory, normal compliance"
+    contact_roles = ("normal_compliance",)
+    history_columns = ("penetration_rms", "stress_L2")
+    scheme = (("memory", "update", ""), ("damage", "linear", "damage_"),
+              ("mech", "semismooth", "mech_"))
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, lam_D=1e-2, lam_u=10.0),
+                               extra={"c_nu": 1e10, "gap": 0.0, "memory_kernel": "constant",
+                                      "memory_amplitude": 1.0, "memory_rate": 1.0,
+                                      "memory_mode": "auto"})
 
     def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
@@ -132,9 +145,7 @@ class ViscoelasticMemoryContact(TimeStepper):
             raise InputError("memory mode 'sum' stores the whole history: no checkpoints")
         return {**super().checkpoint_state(), "memory": self.memory.M}
 
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)
-        self.zeta_old.x.array[:] = self.zeta.x.array
+    def start(self) -> dict:
         its = self._timed("mech", self.mech.solve)
         return {"mech_its": its}
 
@@ -158,6 +169,11 @@ class ViscoelasticMemoryContact(TimeStepper):
         pen = compat.assemble_scalar(self._penetration, self.comm)
         out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
         return out
+
+    def contact_pressure(self):
+        """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
+        from damage_dolfinx.numerics.contact import normal_compliance_pressure
+        return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)
 
     def iteration_totals(self) -> dict:
         return {"damage_ksp": self.damage.iterations, "snes": self.mech.iterations,

@@ -30,15 +30,47 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.numerics.cellwise_stress import StressUpdate
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
-from damage_dolfinx.models.base import ProblemData, TimeStepper
+from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.parameters import ModelParameters
 
 FRICTION_LAWS = ("tresca", "coulomb")
 
 
-class ElastoViscoplasticFriction(TimeStepper):
+class ElastoViscoplasticFriction(Model):
     """Problem VP^{hk} of Section 2.4 (P1 or P2 by ``friction_law``)."""
 
-    extra_history_columns = ["stress_Q", "slip_max", "zeta_min_x", "zeta_min_y"]
+    id = "2.4"
+    title = ("quasistatic elastic-viscoplastic body, Tresca (P1) or simplified Coulomb (P2) "
+             "friction")
+    contact_roles = ("tresca", "coulomb")
+    stability_limit = "explicit viscoplastic term: k <= 2/(1 - zeta*)"
+    checkpoint_fields = ("u", "zeta", "w", "sigma")
+    history_columns = ("stress_Q", "slip_max", "zeta_min_x", "zeta_min_y")
+    scheme = (("friction", "newton", "friction_"), ("damage", "snes-vi", "damage_"))  # (2), (4)
+
+    @classmethod
+    def defaults(cls) -> ModelParameters:
+        return ModelParameters(E=1000.0, nu=0.3, **DAMAGE_A, extra={
+            "friction_law": "tresca", "g_fric": 5.0, "mu_f": 0.05, "S_n": 10.0,
+            "coulomb_normal": "free", "viscoplastic_sign": 1.0, "stress_in_error": "yes",
+            **FRICTION_DEFAULTS})
+
+    @classmethod
+    def k_max(cls, params) -> float:
+        """The explicit viscoplastic rate Ghat = (1 - zeta) Phi_L(sigma) (2.184) multiplies the
+        self-equilibrated stress by 1 + k sign (1 - zeta) per step: with the relaxing sign this
+        is stable iff k (1 - zeta) <= 2, so k_max = 2/(1 - zeta*); with the thesis sign the
+        continuous stress itself grows (by e^{k(1 - zeta)} per step) and the same bound keeps
+        the scheme's growth factor below 3."""
+        return 2.0 / (1.0 - params.zeta_star)
+
+    @classmethod
+    def with_roles(cls, params, roles) -> ModelParameters:
+        """A ``tresca`` boundary selects P1, a ``coulomb`` one P2 (``friction_law``)."""
+        if roles & {"tresca", "coulomb"}:
+            return params.replace(friction_law="coulomb" if "coulomb" in roles else "tresca")
+        return params
 
     def __init__(self, data: ProblemData):
         super().__init__(data)
@@ -104,10 +136,8 @@ class ElastoViscoplasticFriction(TimeStepper):
         return fem.locate_dofs_topological(V, V.mesh.topology.dim - 1, facets)
 
     # -- the scheme
-    def _initial_state(self) -> dict:
-        self.interpolate_zeta0(self.zeta)
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        return {}  # u_0 = 0, sigma_0 = 0: the first step absorbs f_N(0) (docs/models.md, 2.4)
+    # t = 0: u_0 = 0, sigma_0 = 0 (the shared initial state): the first step absorbs f_N(0)
+    # (docs/models.md, 2.4)
 
     def _advance(self) -> dict:
         self.u_old.x.array[:] = self.u.x.array

@@ -232,3 +232,88 @@ def load(path, state: dict):
         index = _match(data[name + "__keys"], _owned_keys(f))
         _values(f)[:] = data[name][index]
         f.x.scatter_forward()
+
+
+# ---------------------------------------------------------------------------- fingerprint
+def fingerprint(ex, stepper) -> dict:
+    """What defines a run besides its time grid and parameters (compared by settings), each
+    item partition-independent: the mesh (cells, vertices, bounding box, facet tags by count),
+    the loads and the damage law by the signature of the UFL they build on this mesh (their
+    literals included: a traction 100 times larger changes it), the initial damage, the
+    boundary parts, irreversibility, the reading and the model's own data (builders)."""
+    import hashlib
+    import ufl
+    from damage_dolfinx.meshes import tag_counts
+    data = stepper.data
+    msh = data.geometry.mesh
+    comm = msh.comm
+    tdim, gdim = msh.topology.dim, msh.geometry.dim
+    x_local = msh.geometry.x[:, :gdim]
+    lo = np.array(x_local.min(axis=0) if len(x_local) else np.full(gdim, np.inf), dtype=float)
+    hi = np.array(x_local.max(axis=0) if len(x_local) else np.full(gdim, -np.inf), dtype=float)
+    comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
+    out = {"mesh": f"{msh.topology.index_map(tdim).size_global} cells, "
+                   f"{msh.topology.index_map(0).size_global} vertices, box "
+                   f"{np.round(lo, 9).tolist()}-{np.round(hi, 9).tolist()}, tags "
+                   f"{sorted(tag_counts(data.geometry).items())}"}
+    x = ufl.SpatialCoordinate(msh)
+    from dolfinx import fem
+    t = fem.Constant(msh, 0.0)
+    dx = ufl.dx(domain=msh)
+
+    def signature(expr):
+        if not isinstance(expr, ufl.core.expr.Expr):
+            return repr(expr)
+        form = (ufl.inner(expr, expr) if expr.ufl_shape else expr) * dx
+        return hashlib.sha1(form.signature().encode()).hexdigest()[:16]
+
+    for name in ("traction", "body_force"):
+        fn = getattr(data, name)
+        out[name] = None if fn is None else signature(fn(x, t))
+    law = data.damage_law or stepper_law(stepper)
+    e, z = ufl.sym(ufl.outer(x, x)), x[0] * 0 + t + 1.0
+    out["damage_law"] = f"{getattr(law, 'name', '?')} {signature(law(e, z, data.params))}"
+    z0 = data.zeta0
+    if callable(z0):
+        pts = np.ascontiguousarray(msh.geometry.x.T)
+        values = np.asarray(z0(pts[:gdim] if gdim < 3 else pts), dtype=float).reshape(-1)
+        digest = [comm.allreduce(float(values.min()) if values.size else np.inf, op=MPI.MIN),
+                  comm.allreduce(float(values.max()) if values.size else -np.inf, op=MPI.MAX)]
+        out["zeta0"] = f"function of x in [{digest[0]:.9g}, {digest[1]:.9g}]"
+    else:
+        out["zeta0"] = float(z0)
+    out["boundaries"] = repr(sorted((str(k), v if isinstance(v, (int, np.integer)) else
+                                     sorted(map(int, v)))
+                                    for k, v in (ex.boundaries or {}).items()))
+    out["irreversible"] = bool(data.irreversible)
+    out["reading"] = getattr(ex, "reading", None)
+    out["builders"] = repr(sorted((str(k), repr(v) if not callable(v) else "function")
+                                  for k, v in (data.builders or {}).items()))
+    return json.loads(io.strict_json(out))
+
+
+def stepper_law(stepper):
+    from damage_dolfinx.laws import thesis_law
+    return thesis_law(stepper.params.variant)
+
+
+#: how the items of the fingerprint are named in a refusal
+_ITEMS = {"mesh": "the mesh", "traction": "the traction", "body_force": "the body force",
+          "damage_law": "the damage law", "zeta0": "the initial damage zeta0",
+          "boundaries": "the boundary parts", "irreversible": "irreversibility",
+          "reading": "the reading", "builders": "the model's own data (builders)"}
+
+
+def verify_fingerprint(ex, stepper, meta, out) -> dict:
+    """The run's fingerprint; on a resume (``meta``: the checkpoint's metadata) InputError with
+    one line naming the first item that differs from the checkpoint's."""
+    fp = fingerprint(ex, stepper)
+    saved = (meta or {}).get("fingerprint")
+    if isinstance(saved, dict):
+        for key in _ITEMS:
+            if key in saved and saved.get(key) != fp.get(key):
+                raise InputError(f"cannot restart: {_ITEMS[key]} differs from the run in "
+                                 f"{str(out)!r} (checkpoint: {saved.get(key)!r}, this run: "
+                                 f"{fp.get(key)!r}); choose another --out to run it")
+    return fp

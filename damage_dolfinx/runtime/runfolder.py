@@ -173,14 +173,14 @@ def read_manifest(out):
     try:
         data = json.loads(path.read_text())
         files = data["files"]
-        if data.get("schema") != MANIFEST_SCHEMA or data.get("kind") not in ("run", "study") \
+        if data.get("schema") != MANIFEST_SCHEMA or data.get("kind") not in ("run", "study", "sweep") \
                 or not isinstance(files, list) or not all(
                     isinstance(f, str) and f and "/" not in f and f not in (".", "..")
                     for f in files):
             raise ValueError("not a damage-dolfinx manifest")
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError(f"{str(path)!r} is unreadable ({exc}); nothing in {str(out)!r} was "
-                         "touched: move the folder aside or choose another --out") from None
+                         "touched: move the folder aside or choose another out folder") from None
     return data["kind"], set(files) | {MANIFEST}
 
 
@@ -248,29 +248,36 @@ def claim_folder(out, kind, planned, restart, overwrite, comm, description=None,
     result = comm.bcast(result, root=0)
     if isinstance(result, InputError):
         raise result
+    if apply:
+        from damage_dolfinx.runtime.collective import track
+        track(out, kind)
     return result
 
 
 def _claim(out, kind, planned, restart, overwrite, description, apply=True):
     found, ours, others = folder_contents(out)
     other_kind = {"run": "study", "study": "run"}[kind]
-    what = {"run": "a run", "study": "a convergence study"}
+    what = {"run": "a run", "study": "a convergence study", "sweep": "a parameter sweep"}
+    if found == "sweep" or (found is None and (out / "points.json").is_file()):
+        found = "sweep"
+        raise InputError(f"{str(out)!r} holds {what[found]}; {what[kind]} needs a folder of "
+                         "its own: choose another --out (nothing was touched)")
     if found == other_kind:
         raise InputError(f"{str(out)!r} holds {what[other_kind]}; {what[kind]} needs a folder "
-                         "of its own: choose another --out (nothing was touched)")
+                         "of its own: choose another out folder (nothing was touched)")
     earlier = found == kind and bool(ours - {MANIFEST, *HIDDEN})
     if others and found is None:
         raise InputError(f"{str(out)!r} holds files damage-dolfinx did not write "
-                         f"({_listing(others)}) and no {MANIFEST}: choose another --out or an "
+                         f"({_listing(others)}) and no {MANIFEST}: choose another out folder or an "
                          "empty folder (nothing was touched)")
     clash = others & {n for p in planned for n in (p, p + ".tmp")}
     if clash:
         raise InputError(f"{str(out)!r} holds {_listing(clash)}, not written by damage-dolfinx "
                          f"(not in its {MANIFEST}), where this {kind} would write: move "
-                         "them or choose another --out (nothing was touched)")
+                         "them or choose another out folder (nothing was touched)")
     if earlier and not restart and not overwrite:
-        raise InputError(f"{str(out)!r} holds {description or what[kind]}; --restart "
-                         "continues it, --overwrite replaces it, or choose another --out")
+        raise InputError(f"{str(out)!r} holds {description or what[kind]}; restart=True "
+                         "continues it, overwrite=True replaces it, or choose another out folder")
     if not apply:
         return earlier
     keep = set()
@@ -318,8 +325,10 @@ def check_mesh_file(path, dim, required_tags=(), comm=MPI.COMM_WORLD):
 
 
 def _mesh_problem(path, dim, required):
-    if not path.is_file():
-        return "does not exist"
+    from damage_dolfinx.validation import cell_types_problem, mesh_path_problem
+    problem = mesh_path_problem(path)
+    if problem:
+        return problem
     try:
         size = path.stat().st_size
         with open(path, "rb") as f:
@@ -340,6 +349,9 @@ def _mesh_problem(path, dim, required):
         got = gmsh.model.getDimension()
         if got != dim or len(gmsh.model.mesh.getElementTypes(dim)) == 0:
             return f"holds a {got}-D mesh, this example needs a {dim}-D one"
+        mixed = cell_types_problem(gmsh, dim)
+        if mixed:
+            return mixed
         if not gmsh.model.getPhysicalGroups(dim):
             return f"has no physical group of dimension {dim} (the cells)"
         tags = {t for _, t in gmsh.model.getPhysicalGroups(dim - 1)}

@@ -20,6 +20,44 @@ class RunInterrupted(Exception):
         self.signum, self.exit_status = signum, 128 + signum
 
 
+#: the first stop signal this process received (0: none); a failure while one is pending is an
+#: interruption (a compiler killed by the terminal's SIGINT fails the JIT compile)
+RECEIVED = {"signum": 0}
+
+
+class SignalStop(KeyboardInterrupt):
+    """A stop signal outside a run's time loop (the command line's handler): the command
+    stops where it is, exit status 128 + signal."""
+
+    def __init__(self, signum: int):
+        super().__init__(f"stopped by {signal.Signals(signum).name}")
+        self.signum, self.exit_status = signum, 128 + signum
+
+
+def stop_outside_runs(signum, frame):
+    """Handler of the command line for SIGTERM and SIGINT outside a run's loop (set-up, a
+    convergence study, a sweep between points): raise SignalStop."""
+    RECEIVED["signum"] = RECEIVED["signum"] or signum
+    raise SignalStop(signum)
+
+
+def import_gmsh_keeping_sigint():
+    """gmsh's Python module sets SIGINT to its default action (killing the process, with no
+    line and no status) when it is first imported: import it now, if it is there, and put the
+    handler back."""
+    import sys
+    if "gmsh" in sys.modules or threading.current_thread() is not threading.main_thread():
+        return
+    handler = signal.getsignal(signal.SIGINT)
+    try:
+        import gmsh  # noqa: F401
+    except Exception:  # noqa: BLE001 - no gmsh: nothing to protect against
+        pass
+    finally:
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
+
+
 class StopSignals:
     """While active, STOP_SIGNALS only set ``signum`` (the runner stops collectively at the end
     of the step); a signal repeated ``FORCE_AFTER`` seconds later ends the process at once (the
@@ -30,6 +68,7 @@ class StopSignals:
 
     def __enter__(self):
         self.signum, self._previous, self._first = 0, {}, None
+        import_gmsh_keeping_sigint()
         if threading.current_thread() is threading.main_thread():
             self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
         return self
@@ -41,6 +80,7 @@ class StopSignals:
             os.kill(os.getpid(), signum)
         if not self.signum:
             self.signum, self._first = signum, now
+            RECEIVED["signum"] = RECEIVED["signum"] or signum
 
     def __exit__(self, *exc):
         for s, handler in self._previous.items():

@@ -26,7 +26,6 @@ import numpy as np
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx.catalogue import examples
 from damage_dolfinx.runtime import io
 from damage_dolfinx.viz import post
 from damage_dolfinx.parameters import InputError, TimeGrid
@@ -268,7 +267,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
                          "a convergence study")
             claimed.append(True)
         return _study(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, serial_max_n,
-                      reference_ranks, defaults, wall_start, settings, claim, claimed)
+                      reference_ranks, defaults, wall_start, settings, claim, claimed, lock)
     finally:
         lock.release()
 
@@ -287,15 +286,17 @@ def _previous_study(out, comm):
 
 
 def _study(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, serial_max_n,
-           reference_ranks, defaults, wall_start, settings, claim, claimed):
+           reference_ranks, defaults, wall_start, settings, claim, claimed, lock=None):
     failed = {"schema": SCHEMA, "status": "failed", **settings}
     try:
         return _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm,
                          serial_max_n, reference_ranks, defaults, wall_start, settings, claim)
-    except (ConvergenceError, InputError) as exc:
+    except (ConvergenceError, InputError, io.OutputError) as exc:
         if not claimed:
             raise
         failed.update(error=str(exc), wall_time_s=time.perf_counter() - wall_start)
+        if lock is not None and comm.rank == 0:
+            lock.free_reserve()  # so that a full disk still takes the status
         try:
             io.write_json(out / "summary.json", failed, comm)
         except OSError:
@@ -412,10 +413,15 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
                "assumptions": ex.assumptions,
                "wall_time_s": time.perf_counter() - wall_start,
                "environment": io.environment(comm)}
+    def tables():
+        if comm.rank == 0:
+            write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
+            label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
+            plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k,
+                             definition)
+    io.collective(comm, out, "the tables and convergence.png", tables)  # OutputError: exit 4
     if comm.rank == 0:
-        write_tables(out, rows, ns, ks, rates, rates_T, ex.id, ref_n, ref_k, definition)
-        label = ex.id + (f", {ex.reading} reading" if ex.readings else "")
-        plot_convergence(out / "convergence.png", rows, rates, label, ref_n, ref_k, definition)
-        print((out / "errors.md").read_text(), flush=True)
-    io.write_json(out / "summary.json", summary, comm)
+        if progress:  # progress=False prints nothing
+            print((out / "errors.md").read_text(), flush=True)
+    io.collective(comm, out, "summary.json", io.write_json, out / "summary.json", summary, comm)
     return summary

@@ -20,6 +20,7 @@ when the sweep runs again; a point that was interrupted reruns from its checkpoi
 from __future__ import annotations
 
 import csv
+import io as io_module
 import itertools
 import json
 import math
@@ -120,20 +121,32 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     of the points not yet finished, then stop (the others stay pending). ``plot``: the final
     scalar drawn against the swept parameters in ``sweep.png``. ``n``, ``k``, ``T`` apply to
     every point."""
+    from damage_dolfinx.runtime.collective import outcome
+    from damage_dolfinx.validation import check_sweep
+    with outcome(comm):
+        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress)
+        return _sweep(problem, out, grid, comm=comm, **checked)
+
+
+def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, progress,
+           comm) -> dict:
     from damage_dolfinx.runtime import io
+    from damage_dolfinx.runtime.collective import describe, mark, track
     from damage_dolfinx.runtime.runner import resolve
     from damage_dolfinx.runtime.runner import run as run_one
-    from damage_dolfinx.numerics.solvers import ConvergenceError
+    from damage_dolfinx.runtime.signals import RunInterrupted
 
     wall_start = time.perf_counter()
     grid = check_grid(grid)
-    if max_points is not None and (isinstance(max_points, bool) or int(max_points) != max_points
-                                   or max_points < 1):
-        raise InputError(f"max_points must be a whole number >= 1, got {max_points!r}")
     points = grid_points(grid)
     ex = resolve(problem)
-    for values in points:  # every point is checked before any work (unknown names, values)
+    checked_at = time.perf_counter()
+    for i, values in enumerate(points):  # every point is checked before any work
         ex.configure(n, k, T, None, dict(values))
+        if progress and comm.rank == 0 and time.perf_counter() - checked_at > 2.0:
+            checked_at = time.perf_counter()
+            print(f"[sweep {ex.id}] checking the grid: {i + 1}/{len(points)} points",
+                  flush=True)
     out = Path(out)
     mapping = {"schema": SCHEMA, "case": ex.id, "grid": grid, "n": n, "k": k, "T": T,
                "points": [{"index": i, "folder": f"point_{i}", "values": values}
@@ -148,13 +161,15 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     if existing is not None and {key: existing.get(key) for key in mapping} != \
             json.loads(json.dumps(mapping)):
         raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
-                         "T in its points.json); choose another --out")
+                         "T in its points.json); choose another out folder")
     out = io.prepare_output_dir(out, comm)
+    states = claim_sweep_folder(out, len(points), restart, comm)
+    track(out, "sweep")
     if comm.rank == 0:
         io.write_json(out / "points.json", mapping, comm)
+        io.write_json(out / "summary.json", {"schema": SCHEMA, "case": ex.id, "status": "running",
+                                              "points": len(points)}, comm)
 
-    states = comm.bcast([_state(out / f"point_{i}") for i in range(len(points))]
-                        if comm.rank == 0 else None, root=0)
     pending = [i for i, s in enumerate(states) if s != "completed"]
     todo = pending[:max_points] if max_points else pending
     together = _runs_on_all_ranks(problem) and comm.size > 1
@@ -163,6 +178,7 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     if comm.rank == 0 and progress:
         print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
               f"running {len(todo)} on {comm.size} rank(s)", flush=True)
+    failures = {}
     for i in mine:
         values = points[i]
         folder = out / f"point_{i}"
@@ -173,12 +189,19 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
                               progress=False, figures=figures, restart=resume,
                               overwrite=not resume, comm=run_comm)
             status = summary["status"]
-        except ConvergenceError as exc:
-            status = f"failed ({exc})"
+        except (RunInterrupted, KeyboardInterrupt):
+            raise  # the sweep stops (collective.outcome decides for every rank)
+        except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
+            if together:
+                raise
+            if run_comm.rank == 0:
+                mark(folder, exc)
+            status = f"failed ({describe(exc)})"
+            failures[i] = describe(exc)
         if progress and run_comm.rank == 0:
             print(f"[sweep {ex.id}] point {i} ({_describe(values)}): {status} in "
                   f"{time.perf_counter() - start:.1f} s (rank {comm.rank})", flush=True)
-    comm.Barrier()
+    failures = {i: why for part in comm.allgather(failures) for i, why in part.items()}
 
     summary = None
     if comm.rank == 0:
@@ -197,10 +220,14 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
                         scalars.append(key)
             rows.append(row)
         columns = ["point", "folder", *grid, *STATUS_COLUMNS, *scalars]
-        with open(out / "sweep.csv", "w", newline="") as f:
-            writer = csv.DictWriter(f, fieldnames=columns, restval="")
+        def table(f):
+            text = io_module.StringIO()
+            writer = csv.DictWriter(text, fieldnames=columns, restval="")
             writer.writeheader()
             writer.writerows(rows)
+            f.write(text.getvalue().encode())
+        io.collective(MPI.COMM_SELF, out, "sweep.csv", io.atomic_write_bytes, out / "sweep.csv",
+                      table)
         done = [r for r in rows if r["status"] == "completed"]
         if plot and plot not in scalars and done:  # the runs are kept: a warning, no plot
             import sys
@@ -208,18 +235,96 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
                   f"problem (known: {', '.join(scalars)})", file=sys.stderr, flush=True)
             plot = None
         if plot and done:
-            plot_sweep(out / "sweep.png", done, grid, plot, ex.id)
-        summary = {"schema": SCHEMA, "case": ex.id, "grid": grid, "points": len(points),
-                   "completed": len(done),
+            io.collective(MPI.COMM_SELF, out, "sweep.png", plot_sweep, out / "sweep.png", done,
+                          grid, plot, ex.id)
+        failed = sorted(i for i, r in enumerate(rows) if str(r["status"]).startswith("failed")
+                        or i in failures)
+        status = "failed" if failed else ("completed" if len(done) == len(points) else
+                                          "incomplete")
+        summary = {"schema": SCHEMA, "case": ex.id, "status": status, "grid": grid,
+                   "points": len(points), "completed": len(done), "failed": failed,
+                   "errors": {str(i): why for i, why in sorted(failures.items())},
                    "pending": [r["point"] for r in rows if r["status"] != "completed"],
                    "ran": todo, "mpi_size": comm.size, "points_on_all_ranks": together,
                    "csv": "sweep.csv", "plot": "sweep.png" if plot and done else None,
                    "wall_time_s": time.perf_counter() - wall_start}
         io.write_json(out / "summary.json", summary, comm)
         if progress:
-            print(f"[sweep {ex.id}] {len(done)}/{len(points)} points completed in "
+            print(f"[sweep {ex.id}] {len(done)}/{len(points)} points completed"
+                  + (f", {len(failed)} failed" if failed else "") + " in "
                   f"{summary['wall_time_s']:.1f} s; table {out / 'sweep.csv'}", flush=True)
     return comm.bcast(summary, root=0)
+
+
+def claim_sweep_folder(out, count, restart, comm) -> list:
+    """The folder rules for a sweep (rank 0 decides, every rank gets the answer): a folder
+    holding a run or a convergence study is refused, and so are files the package did not
+    write (in the folder or in a point's folder); the manifest then lists the sweep's files
+    and point folders. Returns the state of every point (``_state``)."""
+    from damage_dolfinx.runtime import runfolder
+    result = None
+    if comm.rank == 0:
+        try:
+            result = _claim_sweep(Path(out), count)
+        except InputError as exc:
+            result = exc
+        except OSError as exc:
+            result = InputError(f"cannot use {str(out)!r}: {exc.strerror or exc}")
+    result = comm.bcast(result, root=0)
+    if isinstance(result, InputError):
+        raise result
+    del runfolder
+    return result
+
+
+def _claim_sweep(out: Path, count: int) -> list:
+    from damage_dolfinx.runtime import runfolder
+    names = {f"point_{i}" for i in range(count)} | set(SWEEP_FILES)
+    present = {p.name for p in out.iterdir()}
+    known = runfolder.read_manifest(out)
+    if known is not None and known[0] != "sweep":
+        what = {"run": "a run", "study": "a convergence study"}[known[0]]
+        raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
+                         "choose another --out (nothing was touched)")
+    if known is None:
+        legacy = runfolder.folder_contents(out)[0]
+        if legacy is not None:
+            what = {"run": "a run", "study": "a convergence study"}[legacy]
+            raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
+                             "choose another --out (nothing was touched)")
+        ours = set() if "points.json" not in present else \
+            {n for n in present if n in names}  # a sweep written before manifests
+    else:
+        ours = known[1]
+    others = present - ours - {runfolder.MANIFEST, *runfolder.HIDDEN} - \
+        {n + ".tmp" for n in ours}
+    if others:
+        raise InputError(f"{str(out)!r} holds {runfolder._listing(others)}, not written by "
+                         f"damage-dolfinx (not in its {runfolder.MANIFEST}): move them or "
+                         "choose another --out (nothing was touched)")
+    states = []
+    for i in range(count):
+        folder = out / f"point_{i}"
+        state = _state(folder)
+        if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+            raise InputError(f"{str(folder)!r} is not a folder of this sweep: move it or choose "
+                             "another --out (nothing was touched)")
+        if folder.is_dir():
+            kind, _, strangers = runfolder.folder_contents(folder)
+            if strangers:
+                raise InputError(f"{str(folder)!r} holds {runfolder._listing(strangers)}, not "
+                                 "written by damage-dolfinx: move them or choose another --out "
+                                 "(nothing was touched)")
+            if kind not in (None, "run"):
+                raise InputError(f"{str(folder)!r} holds a convergence study: choose another "
+                                 "--out (nothing was touched)")
+        states.append(state)
+    runfolder.write_manifest(out, "sweep", names | (ours & present))
+    return states
+
+
+#: files of a sweep folder (besides point_<i>/ and the manifest)
+SWEEP_FILES = ("points.json", "sweep.csv", "sweep.png", "summary.json")
 
 
 def plot_sweep(path, rows, grid, scalar, label):

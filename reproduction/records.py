@@ -8,7 +8,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]  # the checkout (damage_dolfinx/report/records.py)
+from reproduction import CHECKOUT
+
+REPO = CHECKOUT
 REFERENCE = REPO / "benchmarks" / "reference_output"
 
 

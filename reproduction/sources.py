@@ -9,7 +9,7 @@ import json
 import re
 from pathlib import Path
 
-from damage_dolfinx.report.records import REFERENCE, REPO
+from reproduction.records import REFERENCE, REPO
 
 
 def _load_json(path: Path):
@@ -33,8 +33,7 @@ def _study_folder(results: Path, name: str):
 
 
 def _fidelity(results: Path):
-    """benchmarks/reproduction/fidelity.py's comparison (None if the script is absent, e.g. an installed
-    package without the repository)."""
+    """benchmarks/reproduction/fidelity.py's comparison (None if the script is absent)."""
     import importlib.util
     script = REPO / "benchmarks" / "reproduction" / "fidelity.py"
     if not script.is_file():

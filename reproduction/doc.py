@@ -12,7 +12,7 @@ import re
 import shutil
 from pathlib import Path
 
-from damage_dolfinx.report.text import reader_text
+from reproduction.text import reader_text
 
 
 class Doc:

@@ -1,0 +1,153 @@
+"""What a run writes as it goes (:class:`RunRecords`, the bookkeeping half of
+:class:`~damage_dolfinx.runtime.loop.Run`): summary.json, history rows with the column contract,
+XDMF fields, checkpoints, figures, the per-step collective checks and the interrupt."""
+from __future__ import annotations
+
+import math
+import signal
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from mpi4py import MPI
+
+from damage_dolfinx.runtime import checkpoint, io
+from damage_dolfinx.numerics.damage import fast_path_counts
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
+                                              claim_folder, previous_run)
+from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
+from damage_dolfinx.numerics.solvers import ConvergenceError
+
+
+from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  # noqa: F401
+                                           Progress, solver_step, state_problem)
+from damage_dolfinx.runtime.figures import auto_amplification, draw_figure  # noqa: F401
+
+
+
+class ColumnError(RuntimeError):
+    """A model reported a scalar that no history column takes, or left a declared one out."""
+
+
+class RunRecords:
+    # -- what a step writes
+    def wall_time(self) -> float:
+        return self.previous_wall + time.perf_counter() - self.wall_start
+
+    def at(self, name):
+        return f"{name} at step {self.stepper.n} (t = {self.stepper.t:.6g})"
+
+    def write_summary(self):
+        io.collective(self.comm, self.out, self.at("summary.json"), io.write_json,
+                      self.out / "summary.json", self.summary, self.comm)
+
+    def save_checkpoint(self):
+        self.write_summary()  # first: the summary is never behind the checkpoint
+        stepper = self.stepper
+        checkpoint.save(self.out, stepper.checkpoint_state(), {
+            **self.settings, "parameters": self.summary["parameters"], "step": stepper.n,
+            "t": stepper.t, "mpi_size": self.comm.size, "wall_time_s": self.wall_time(),
+            "restarts": self.summary.get("restarts", [])}, self.comm)
+        self.last_checkpoint.update(time=time.perf_counter(), step=stepper.n)
+
+    def end_of_step(self):
+        """One allreduce per step: seconds since the last checkpoint and since the start, the
+        signal received (if any) and whether the history row failed, agreed by all ranks."""
+        now = time.perf_counter()
+        bad, detail = state_problem(self.stepper)
+        state = np.array([now - self.last_checkpoint["time"], now - self.wall_start,
+                          self.signals.signum, float(self.history.error is not None), bad])
+        self.comm.Allreduce(MPI.IN_PLACE, state, op=MPI.MAX)
+        if state[3]:
+            reason = self.comm.bcast(io.describe(self.history.error, self.out)
+                                     if self.comm.rank == 0 else None)
+            raise io.OutputError(f"cannot write {self.at('history.csv')}: {reason}")
+        if state[4]:
+            self.check_state()  # raises (the detail from a rank that has it)
+        return state[0], state[1], int(state[2])
+
+    def check_state(self):
+        """Stop on a NaN/Inf or a zeta outside [zeta_star, 1] on any rank (collective)."""
+        bad, detail = state_problem(self.stepper)
+        ranks = self.comm.allgather(detail if bad else None)
+        detail = next((d for d in ranks if d), None)
+        if detail:
+            raise ConvergenceError(f"{self.at('the state')}: {detail}; the run is stopped (the "
+                                   "model or its data gave numbers that cannot be right)")
+
+    def checkpoint_due(self, since_checkpoint) -> bool:
+        if not self.supported:
+            return False
+        if self.options["checkpoint_every"]:
+            return self.stepper.n % self.options["checkpoint_every"] == 0
+        seconds = self.options["checkpoint_seconds"]
+        return bool(seconds) and since_checkpoint > seconds
+
+    def record(self, stats, step_time, row=True):
+        """The step's scalars into the summary and (``row``) a history.csv row."""
+        stepper = self.stepper
+        scalars = stepper.scalars()
+        if row:
+            values = {"step": stepper.n, "t": stepper.t, **scalars, **stats,
+                      "step_time_s": f"{step_time:.4g}"}
+            self.check_columns(values)
+            self.history.write(values)
+        self.recorded = stepper.n
+        self.summary.update(steps_done=stepper.n, t_final=stepper.t, final=scalars,
+                            iterations={**stepper.iteration_totals(),
+                                        **fast_path_counts(stepper)},
+                            wall_time_s=self.wall_time(), **stepper.summary_extra())
+        return scalars
+
+    def check_columns(self, values):
+        """Every value has its column, and every column the model declares has its value
+        after each step (the initial state has no step statistics)."""
+        extra = sorted(set(values) - self.columns)
+        missing = sorted(set(self.model_columns) - set(values)) if values["step"] > 0 else []
+        if extra or missing:
+            raise ColumnError(
+                f"model {type(self.stepper).__name__}: "
+                + (f"scalars {extra} have no history column (declare them in "
+                   "history_columns)" if extra else "")
+                + ("; " if extra and missing else "")
+                + (f"declared columns {missing} were not written" if missing else ""))
+
+    def up_to_date(self, stats, step_time):
+        """The summary of the current step (a step between history rows has none yet)."""
+        if self.recorded != self.stepper.n:
+            self.record(stats, step_time, row=False)
+
+    def write_fields(self):
+        self.fields_at = self.stepper.n
+        self.stepper.update_output()
+        io.collective(self.comm, self.out, self.at(f"{self.xdmf_name} (+ .h5)"),
+                      self.xdmf.write, self.stepper.output_fields, self.stepper.t)
+        self.write_summary()
+
+    def figure(self, fig, suffix=""):
+        def draw():
+            add_to_manifest(self.out, [fig.filename.replace(".png", f"{suffix}.png")], self.comm)
+            self.summary["outputs"]["figures"].append(
+                draw_figure(self.ex, fig, self.stepper, self.out, suffix))
+        io.collective(self.comm, self.out, self.at(fig.filename), draw)
+
+    def timed_figures(self):
+        """Figures requested at the current time (Figure.times)."""
+        for fig in self.ex.figures if self.options["figures"] else []:
+            if any(abs(self.stepper.t - t) < 0.5 * self.grid.k for t in fig.times):
+                self.stepper.update_output()
+                self.figure(fig, suffix=f"_t{self.stepper.t:g}")
+
+    def interrupt(self, signum):
+        name = signal.Signals(signum).name
+        if self.supported:
+            self.save_checkpoint()
+        self.summary.update(status="interrupted", signal=name, wall_time_s=self.wall_time())
+        self.write_summary()
+        kept = ("checkpoint written; restart=True continues the run" if self.supported
+                else f"example {self.ex.id} has no checkpoints: the history and fields so far "
+                "stay")
+        raise RunInterrupted(signum, f"stopped by {name} after step {self.stepper.n} "
+                                     f"(t = {self.stepper.t:.6g}): {kept}")

@@ -1,0 +1,403 @@
+"""The one validation layer of the public API (and of the command line, which maps onto it):
+every argument of :class:`~damage_dolfinx.Problem`, :func:`~damage_dolfinx.run`,
+:func:`~damage_dolfinx.converge`, :func:`~damage_dolfinx.sweep`,
+:func:`~damage_dolfinx.read_mesh` and :func:`~damage_dolfinx.from_gmsh` is checked here for its
+type, its range and, once the mesh exists, its shape against the mesh dimension (loads and
+damage laws are evaluated symbolically in UFL, nothing is assembled). A failure raises
+:class:`~damage_dolfinx.InputError` naming the argument and what was expected; the checks are
+deterministic, so every rank refuses alike, before any file is written.
+
+NumPy scalars are accepted wherever a number is (``T=np.int64(1)``); booleans are not numbers.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+from pathlib import Path
+
+import numpy as np
+
+from damage_dolfinx.parameters import InputError
+
+#: the largest sweep grid (points); larger grids are refused before any work
+MAX_SWEEP_POINTS = 10000
+
+
+# ---------------------------------------------------------------------------- scalars
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def is_real(value) -> bool:
+    return isinstance(value, (numbers.Real, np.floating, np.integer)) and \
+        not isinstance(value, (bool, np.bool_))
+
+
+def real(name, value, *, low=None, high=None, low_open=False, allow_none=False,
+         what="a number") -> float | None:
+    """``value`` as a finite float in the range, or InputError naming ``name``."""
+    if value is None and allow_none:
+        return None
+    if not is_real(value):
+        raise InputError(f"{name} must be {what}, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    v = float(value)
+    if not math.isfinite(v):
+        raise InputError(f"{name} must be a finite number, got {v}")
+    if low is not None and (v <= low if low_open else v < low):
+        raise InputError(f"{name} must be {'>' if low_open else '>='} {low:g}, got {v:g}")
+    if high is not None and v > high:
+        raise InputError(f"{name} must be <= {high:g}, got {v:g}")
+    return v
+
+
+def positive(name, value, allow_none=False):
+    return real(name, value, low=0.0, low_open=True, allow_none=allow_none,
+                what="a positive number")
+
+
+def whole(name, value, *, low=1, allow_none=False) -> int | None:
+    """``value`` as an int >= ``low`` (a float with a whole value is not accepted: a level or
+    a count is a whole number)."""
+    if value is None and allow_none:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Integral,
+                                                                      np.integer)):
+        raise InputError(f"{name} must be a whole number >= {low}, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    if int(value) < low:
+        raise InputError(f"{name} must be a whole number >= {low}, got {int(value)}")
+    return int(value)
+
+
+def flag(name, value) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"{name} must be True or False, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    return bool(value)
+
+
+def text(name, value, allow_none=False) -> str | None:
+    if value is None and allow_none:
+        return None
+    if not isinstance(value, str) or not value:
+        raise InputError(f"{name} must be a non-empty text, got {_shown(value)}")
+    return value
+
+
+def levels(name, values, cast) -> list:
+    """A non-empty list of levels (``cast(name[i], v)``); a bare number is refused with the
+    list form as the expected one."""
+    if isinstance(values, (str, bytes, dict)) or not hasattr(values, "__iter__"):
+        raise InputError(f"{name} must be a list, e.g. {name}=[{_shown(values)}], got "
+                         f"{_shown(values)} ({type(values).__name__})")
+    values = list(values)
+    if not values:
+        raise InputError(f"{name} must list at least one value")
+    out = [cast(f"{name}[{i}]", v) for i, v in enumerate(values)]
+    if len(set(out)) != len(out):
+        raise InputError(f"{name} lists a value twice: {out}")
+    return out
+
+
+def path(name, value, allow_none=False):
+    if value is None and allow_none:
+        return None
+    if not isinstance(value, (str, Path)) or not str(value):
+        raise InputError(f"{name} must be a folder path (text), got {_shown(value)} "
+                         f"({type(value).__name__})")
+    return value
+
+
+# ---------------------------------------------------------------------------- Problem
+def check_problem(problem):
+    """The problem with its scalars normalised (NumPy scalars to Python), or InputError.
+    Called where the Problem is turned into a run (``Problem.example``)."""
+    from damage_dolfinx.laws import DamageLaw
+    from damage_dolfinx.models.registry import MODELS, model as model_class
+    from damage_dolfinx.parameters import ModelParameters
+    model = problem.model
+    if isinstance(model, np.str_):
+        model = str(model)
+    if not isinstance(model, (str, type)):
+        raise InputError(f"model must be a model id ({', '.join(MODELS)}) or a model class, "
+                         f"got {_shown(model)}")
+    info = model_class(model)  # InputError for an unknown id
+    T = positive("T (final time)", problem.T)
+    k = positive("k (time step)", problem.k, allow_none=True)
+    if k is not None and k > T * (1 + 1e-12):
+        raise InputError(f"k (time step) must not exceed T = {T:g}, got k = {k:g}")
+    n = whole("n (mesh level)", problem.n, allow_none=True)
+    mesh = problem.mesh
+    _check_mesh_argument(mesh)
+    roles = _check_boundaries(problem.boundaries, info)
+    params = problem.params
+    if params is not None and not isinstance(params, (dict, ModelParameters)):
+        raise InputError(f"params must be a dict of changes or a ModelParameters "
+                         f"(model_defaults({info.id!r})), got {type(params).__name__}")
+    if isinstance(params, ModelParameters):
+        _check_parameters_of(params, info)
+    elif isinstance(params, dict):
+        params = {_key("params", key): _param_value(key, value) for key, value in params.items()}
+    for name in ("traction", "body_force"):
+        value = getattr(problem, name)
+        if value is not None and not callable(value):
+            raise InputError(f"{name} must be a function (x, t) -> UFL vector, got "
+                             f"{_shown(value)} ({type(value).__name__})")
+    if problem.traction is not None and roles is not None and "traction" not in roles:
+        raise InputError("traction is given but no boundary part has the 'traction' role: "
+                         "add boundaries={'traction': tag, ...} (else the load acts nowhere)")
+    zeta0 = problem.zeta0
+    if not callable(zeta0):
+        zeta0 = real("zeta0 (initial damage)", zeta0, low=0.0, high=1.0, low_open=True,
+                     what="a number in (0, 1] or a function of x")
+    if problem.damage_law is not None and not isinstance(problem.damage_law, DamageLaw):
+        raise InputError(f"damage_law must be a damage_dolfinx.DamageLaw (DamageLaw(function, "
+                         f"name)), got {_shown(problem.damage_law)}")
+    irreversible = flag("irreversible", problem.irreversible)
+    allow = flag("allow_unstable", problem.allow_unstable)
+    name = text("name", problem.name)
+    if "/" in name or name in (".", ".."):
+        raise InputError(f"name must not contain '/', got {name!r}")
+    if not isinstance(problem.builders, dict):
+        raise InputError(f"builders must be a dict, got {type(problem.builders).__name__}")
+    checked = dataclasses.replace(problem, model=model, T=T, k=k, n=n, params=params,
+                                  zeta0=zeta0, irreversible=irreversible,
+                                  allow_unstable=allow, name=name)
+    zeta_star = checked.parameters().zeta_star
+    if not callable(zeta0) and zeta0 < zeta_star:
+        raise InputError(f"zeta0 (initial damage) must lie in [zeta_star, 1] = [{zeta_star:g}, "
+                         f"1], got {zeta0:g}")
+    return checked
+
+
+def _check_mesh_argument(mesh):
+    from damage_dolfinx.geometries import Geometry
+    if isinstance(mesh, Geometry) or callable(mesh):
+        return
+    if isinstance(mesh, tuple):
+        if len(mesh) != 2:
+            raise InputError(f"mesh as a tuple must be (mesh, facet_tags), got {len(mesh)} items")
+        return
+    if isinstance(mesh, (str, Path)):
+        problem = mesh_path_problem(Path(mesh))
+        if problem:
+            raise InputError(f"mesh file {str(mesh)!r}: {problem}")
+        return
+    raise InputError("mesh must be a Geometry, a (mesh, facet_tags) pair, a .msh path or a "
+                     f"function (comm, n) -> one of these; got {type(mesh).__name__}")
+
+
+def mesh_path_problem(p: Path):
+    """What is wrong with a mesh file path before it is opened (None: nothing)."""
+    if p.is_dir():
+        return "is a folder, not a gmsh .msh file"
+    if p.is_symlink() and not p.exists():
+        return "is a dangling symbolic link"
+    if not p.exists():
+        return "does not exist"
+    if not p.is_file():
+        return "is not a regular file"
+    return None
+
+
+def _check_boundaries(boundaries, info):
+    """The roles named, or None (the mesh's own tags)."""
+    if boundaries is None:
+        return None
+    if not isinstance(boundaries, dict) or not boundaries:
+        raise InputError("boundaries must be a dict {role: tag or [tags]}, got "
+                         f"{_shown(boundaries)}")
+    allowed = ("clamped", "traction") + tuple(info.contact_roles)
+    for role, tags in boundaries.items():
+        if role not in allowed:
+            raise InputError(f"boundaries: role {role!r} is not one of model {info.id}'s: "
+                             f"{', '.join(allowed)}")
+        listed = [tags] if is_real(tags) else tags
+        if isinstance(listed, (str, bytes, dict)) or not hasattr(listed, "__iter__"):
+            raise InputError(f"boundaries[{role!r}] must be a facet tag or a list of tags, got "
+                             f"{_shown(tags)}")
+        listed = list(listed)
+        if not listed:
+            raise InputError(f"boundaries[{role!r}] lists no facet tag")
+        for tag in listed:
+            whole(f"boundaries[{role!r}] (a facet tag)", tag, low=0)
+    return set(boundaries)
+
+
+def _key(name, key):
+    if not isinstance(key, str) or not key:
+        raise InputError(f"{name}: names must be text, got {_shown(key)}")
+    return key
+
+
+def _param_value(key, value):
+    """A parameter value: a number (NumPy scalars to Python), a flag or a word."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if is_real(value):
+        v = float(value) if isinstance(value, (float, np.floating)) else int(value)
+        if isinstance(v, float) and math.isnan(v):
+            raise InputError(f"params[{key!r}] must be a number, got nan")
+        return v
+    if isinstance(value, str) or value is None or callable(value):
+        return value
+    raise InputError(f"params[{key!r}] must be a number, a flag or a word, got "
+                     f"{_shown(value)} ({type(value).__name__})")
+
+
+def _check_parameters_of(params, info):
+    """A ModelParameters built for another model (model_defaults('3.3') given to a 2.2
+    problem) lacks this model's data."""
+    own = info.defaults()
+    missing = sorted(set(own.extra) - set(params.extra))
+    if missing:
+        raise InputError(f"params: a ModelParameters without model {info.id}'s data "
+                         f"({', '.join(missing)}); start from model_defaults({info.id!r})")
+
+
+# ---------------------------------------------------------------------------- with the mesh
+def check_data(data):
+    """The loads, the damage law, the initial damage and the boundary parts against the mesh
+    (called once the geometry exists, before any solver is set up): shapes from the UFL
+    expressions the user's functions build, evaluated symbolically."""
+    import ufl
+    from damage_dolfinx.laws import THESIS_A, THESIS_B
+    msh = data.geometry.mesh
+    gdim = msh.geometry.dim
+    x = ufl.SpatialCoordinate(msh)
+    t = _time_constant(msh)
+    for name in ("traction", "body_force"):
+        fn = getattr(data, name)
+        if fn is None:
+            continue
+        value = _call(name, "(x, t)", fn, x, t)
+        _expect_shape(name, value, (gdim,), f"a UFL vector of {gdim} components "
+                      f"(ufl.as_vector(({', '.join(['...'] * gdim)})))")
+    if data.traction is not None:
+        from damage_dolfinx.meshes import tag_counts
+        from damage_dolfinx.models.registry import TRACTION
+        if not tag_counts(data.geometry).get(TRACTION):
+            raise InputError("traction is given but the mesh has no boundary part with the "
+                             f"traction role (tag {TRACTION}): name it in boundaries")
+    law = data.damage_law
+    if law is not None and law not in (THESIS_A, THESIS_B):
+        e = ufl.sym(ufl.outer(x, x))
+        z = x[0] * 0 + t + 1.0
+        value = _call(f"damage_law {law.name!r}", "(eps, zeta, params)", law, e, z, data.params)
+        _expect_shape(f"damage_law {law.name!r}", value, (), "a UFL scalar")
+    z0 = data.zeta0
+    if callable(z0):  # at the mesh nodes, where the P1 interpolation takes it
+        from mpi4py import MPI
+        pts = np.ascontiguousarray(msh.geometry.x.T)
+        pts = pts[:gdim] if gdim < 3 else pts
+        try:
+            values = np.asarray(z0(pts), dtype=float)
+        except Exception as exc:  # noqa: BLE001 - a user function: named, one line
+            raise InputError(f"zeta0(x) raised {type(exc).__name__}: {exc} (x: a NumPy array of "
+                             f"shape ({gdim}, N))") from None
+        if values.shape not in ((pts.shape[1],), (1, pts.shape[1])):
+            raise InputError(f"zeta0(x) must return one value per point (shape (N,)), got "
+                             f"shape {values.shape} for N = {pts.shape[1]}")
+        comm = msh.comm
+        lo = comm.allreduce(float(np.min(values)) if values.size else np.inf, op=MPI.MIN)
+        hi = comm.allreduce(float(np.max(values)) if values.size else -np.inf, op=MPI.MAX)
+        zs = data.params.zeta_star
+        if not (np.isfinite(lo) and np.isfinite(hi)) or lo < zs - 1e-12 or hi > 1.0 + 1e-12:
+            raise InputError(f"zeta0(x) must lie in [zeta_star, 1] = [{zs:g}, 1] at every mesh "
+                             f"node, got values in [{lo:.4g}, {hi:.4g}]")
+
+
+def _time_constant(msh):
+    from damage_dolfinx import compat  # noqa: F401 - fem.Constant is the same everywhere
+    from dolfinx import fem
+    return fem.Constant(msh, 0.0)
+
+
+def _call(name, signature, fn, *args):
+    try:
+        return fn(*args)
+    except InputError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a user function: named, one line
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        raise InputError(f"{name}{signature} cannot be built from UFL arguments: "
+                         f"{type(exc).__name__}: {first}") from None
+
+
+def _expect_shape(name, value, shape, expected):
+    import ufl
+    from ufl.core.expr import Expr
+    if isinstance(value, (tuple, list)):
+        raise InputError(f"{name} must return {expected}, got a {type(value).__name__} "
+                         "(wrap it in ufl.as_vector)")
+    if is_real(value) and shape == ():
+        return
+    if not isinstance(value, Expr):
+        raise InputError(f"{name} must return {expected}, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    if value.ufl_shape != shape or value.ufl_free_indices:
+        got = "a scalar" if value.ufl_shape == () else f"shape {value.ufl_shape}"
+        raise InputError(f"{name} must return {expected}, got {got}")
+    del ufl
+
+
+# ---------------------------------------------------------------------------- entry points
+def check_run(n=None, k=None, T=None, restart=False, overwrite=False, checkpoint_every=None,
+              progress=True, figures=True, out=None):
+    """The arguments of run() besides the problem."""
+    path("out", out)
+    return dict(n=whole("n", n, allow_none=True), k=positive("k", k, allow_none=True),
+                T=positive("T", T, allow_none=True), restart=flag("restart", restart),
+                overwrite=flag("overwrite", overwrite),
+                checkpoint_every=whole("checkpoint_every", checkpoint_every, allow_none=True),
+                progress=flag("progress", progress), figures=flag("figures", figures))
+
+
+def check_converge(n, k, ref_n, ref_k, T):
+    """The levels of converge(): lists of whole n and positive k, the reference's, T."""
+    return (levels("n", n, whole), levels("k", k, positive), whole("ref_n", ref_n),
+            positive("ref_k", ref_k), positive("T", T, allow_none=True))
+
+
+def check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress):
+    """The arguments of sweep() besides the problem and the grid's values (check_grid)."""
+    if isinstance(grid, dict) and grid:
+        sizes = [len(v) if hasattr(v, "__len__") and not isinstance(v, (str, bytes)) else 1
+                 for v in grid.values()]
+        total = math.prod(sizes)
+        if total > MAX_SWEEP_POINTS:
+            raise InputError(f"the grid has {total:.3g} points ({' x '.join(map(str, sizes))}), "
+                             f"more than {MAX_SWEEP_POINTS}: split it into several sweeps")
+    return dict(n=whole("n", n, allow_none=True), k=positive("k", k, allow_none=True),
+                T=positive("T", T, allow_none=True), restart=flag("restart", restart),
+                max_points=whole("max_points", max_points, allow_none=True),
+                plot=text("plot", plot, allow_none=True), figures=flag("figures", figures),
+                progress=flag("progress", progress))
+
+
+def check_mesh_reading(path_value, dim):
+    """read_mesh's arguments: a path to a regular file, a dimension 2 or 3 (or None)."""
+    if not isinstance(path_value, (str, Path)) or not str(path_value):
+        raise InputError(f"read_mesh: path must be a file path, got {_shown(path_value)}")
+    check_dim(dim)
+    problem = mesh_path_problem(Path(path_value))
+    if problem:
+        raise InputError(f"mesh file {str(path_value)!r} {problem}")
+
+
+def check_dim(dim):
+    if dim is not None and (not is_real(dim) or int(dim) != dim or int(dim) not in (2, 3)):
+        raise InputError(f"dim must be 2, 3 or None, got {_shown(dim)}")
+
+
+def cell_types_problem(gmsh, d):
+    """One cell type only (DOLFINx meshes have one; a mixed file would crash the reader)."""
+    types = gmsh.model.mesh.getElementTypes(d)
+    if len(types) > 1:
+        names = [gmsh.model.mesh.getElementProperties(t)[0] for t in types]
+        return (f"it mixes cell types ({', '.join(names)}); a mesh needs one cell type "
+                "(gmsh: Mesh.RecombineAll 0 for triangles, or recombine every surface)")
+    return None
