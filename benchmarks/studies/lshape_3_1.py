@@ -46,7 +46,7 @@ def run(h, k, T, active):
                 "penetration_rms_T": s["penetration_rms"], "steps": st.num_steps,
                 "ms_per_step": 1e3 * float(np.mean(step_times)),
                 "timings_s": dict(st.timings), "wall_s": time.perf_counter() - start,
-                "k_max": st.stability.get("k_max"), "mesh": st.mesh_info()}
+                "k_max": st.stability.get("k_max") or st.stability.get("k_max_lower_bound"), "mesh": st.mesh_info()}
 
 
 def side_by_side(steppers, field_name, amplification, path, title, label, mesh_only=False):

@@ -41,7 +41,8 @@ def catalogue_k_max(example_id, **mesh):
     """k_max (and details) that the example's stepper computes at construction."""
     ex = examples.get(example_id)
     start = time.perf_counter()
-    st = ex.build(COMM, k=ex.k, T=ex.k, overrides={"stability_check": "warn"}, **mesh)
+    with exact_estimates():
+        st = ex.build(COMM, k=ex.k, T=ex.k, overrides={"stability_check": "warn"}, **mesh)
     info = dict(getattr(st, "stability", None) or {"k_max": getattr(st, "k_max", None)})
     info.update(example=example_id, mesh=mesh, k=ex.k, cells=st.mesh_info()["cells"],
                 time_s=time.perf_counter() - start)

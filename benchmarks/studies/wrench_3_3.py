@@ -103,7 +103,7 @@ if comm.rank == 0:
     plot_penetration(out / "run" / "history.csv", out / "penetration.png")
     u_max = float(np.max(np.linalg.norm(final["u"], axis=1)))
     result = {
-        "h": args.h, "k": k, "k_max": summary.get("k_max", k_max), "T": args.T,
+        "h": args.h, "k": k, "k_max": summary.get("k_max") or k_max, "T": args.T,
         "elastic_term": args.elastic_term, "status": summary["status"],
         "steps": summary["steps_done"], "wall_time_s": summary["wall_time_s"],
         "mpi_size": comm.size, "mesh": summary["mesh"],

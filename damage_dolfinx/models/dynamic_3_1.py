@@ -165,6 +165,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         if not self.stability:
             return {}
         return {"k_max": self.stability["k_max"], "k_over_k_max": self.stability["k_over_k_max"],
+                "k_max_lower_bound": self.stability.get("k_max_lower_bound"),
                 "stability": self.stability}
 
     # -- scalars: ||v||_L2, max |u| at the nodes, RMS penetration on Gamma_C

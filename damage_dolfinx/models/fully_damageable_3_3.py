@@ -308,6 +308,7 @@ class FullyDamageableContact(Model):
             "" if self.elastic_term == "explicit" else " (G33 deviation, not the thesis scheme)")}
         if self.stability:
             out.update(k_max=self.stability["k_max"], k_over_k_max=self.stability["k_over_k_max"],
+                       k_max_lower_bound=self.stability.get("k_max_lower_bound"),
                        stability=self.stability)
         out.update(self.contact.summary())
         out.update(self.probe.summary())

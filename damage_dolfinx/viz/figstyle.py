@@ -139,8 +139,14 @@ def boundary_edges(xy):
     a, b = np.round(edges[:, 0], 9), np.round(edges[:, 1], 9)
     swap = ((a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1])))[:, None]
     key = np.hstack([np.where(swap, b, a), np.where(swap, a, b)])
-    _, idx, counts = np.unique(key, axis=0, return_index=True, return_counts=True)
-    return edges[idx[counts == 1]]
+    # one lexsort of the four coordinates (np.unique(axis=0) sorts rows as objects: 8x slower)
+    order = np.lexsort(key.T[::-1])
+    ks = key[order]
+    new = np.ones(len(ks) + 1, dtype=bool)
+    new[1:-1] = np.any(ks[1:] != ks[:-1], axis=1)
+    starts = np.flatnonzero(new)
+    single = starts[:-1][np.diff(starts) == 1]
+    return edges[order[single]]
 
 
 def draw_outline(ax, ref_xy, label="undeformed outline"):
