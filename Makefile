@@ -16,7 +16,7 @@ export OMP_NUM_THREADS := 1
 export MPLBACKEND := Agg
 
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix \
-    python3-ffcx python3-gmsh gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
+    python3-ffcx python3-gmsh python3-h5py gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
     python3-venv python3-setuptools gcc chromium \
     python3-sphinx python3-myst-parser python3-sphinx-gallery furo libjs-mathjax
 # As root (containers, CI runners) apt-get runs directly; otherwise through sudo. `env` carries
@@ -31,7 +31,7 @@ setup: $(VENV)/.installed
 
 # Install the Debian stack only if /usr/bin/python3 cannot already import it.
 system-deps:
-	@if /usr/bin/python3 -c "import dolfinx, petsc4py, mpi4py, ufl, basix, ffcx, gmsh, matplotlib, pytest, scipy, \
+	@if /usr/bin/python3 -c "import dolfinx, petsc4py, mpi4py, ufl, basix, ffcx, gmsh, h5py, matplotlib, pytest, scipy, \
 	    sphinx, myst_parser, sphinx_gallery, furo" \
 	    2>/dev/null && command -v mpirun >/dev/null && command -v chromium >/dev/null \
 	    && [ -f /usr/share/javascript/mathjax/MathJax.js ]; then \
@@ -109,6 +109,10 @@ cross-version:
 check-paraview: setup
 	@command -v pvpython >/dev/null && command -v xvfb-run >/dev/null || $(APT) install -y python3-paraview xvfb xauth
 	$(PY) benchmarks/platforms/cross_version.py run --out $(OUT)/paraview-runs
+	$(PY) -m damage_dolfinx.cli run 2.4-ex1 --n 8 --k 0.01 --T 0.5 --no-figures --quiet --overwrite \
+	    --out $(OUT)/paraview-runs/restarted
+	$(MPIRUN) $(PY) -m damage_dolfinx.cli run 2.4-ex1 --n 8 --k 0.01 --T 1 --restart --no-figures \
+	    --quiet --out $(OUT)/paraview-runs/restarted
 	$(PY) benchmarks/platforms/paraview_check.py $$(ls -d $(OUT)/paraview-runs/*/) --out $(OUT)/paraview-check
 
 clean:

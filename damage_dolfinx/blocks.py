@@ -26,6 +26,10 @@ Friction solvers (second-kind inequalities, prefix ``friction_``):
     (a solver by name: ``newton``, or a registered alternative), :data:`FRICTION_DEFAULTS`.
 Boundary conditions:
     :func:`clamped` (u = 0 on a tag).
+Spaces and fields:
+    :func:`vector_p1`, :func:`scalar_p1` (P1 Lagrange), :func:`scalar_dg0`, :func:`tensor_dg0`,
+    :func:`interpolate` (a Function from a UFL expression or a function of x),
+    :func:`expression` (a compiled UFL expression for :func:`interpolate`).
 Stability of explicit terms:
     :func:`estimate_k_max` (largest eigenvalue of M^-1 K with the viscosity C; MPI),
     :func:`check_time_step` (k against k_max: error, warn or off).
@@ -33,6 +37,8 @@ Solvers:
     :class:`LinearSolver`, :class:`NonlinearSolver` (PETSc options prefixes),
     :class:`SolveContext`, :class:`ConvergenceError`.
 """
+from damage_dolfinx.compat import (expression, interpolate, scalar_dg0, scalar_p1, tensor_dg0,
+                                   vector_p1)
 from damage_dolfinx.forms.kelvin_voigt import (damaged_elastic_stress, kelvin_voigt_stress,
                                                viscous_stress)
 from damage_dolfinx.forms.elastic_damage import load
@@ -55,7 +61,8 @@ __all__ = ["B", "ConvergenceError", "DamageLaw", "DamageStep", "FRICTION_DEFAULT
            "FrictionProblem", "LinearSolver", "MemoryKernel", "MemoryTerm", "NonlinearSolver",
            "OMEGA_PD", "Phi_L", "RHO_UZAWA", "RegularisedNewton", "SolveContext", "bilateral",
            "check_time_step", "clamped", "coulomb_bound", "damaged_elastic_stress", "eps",
-           "estimate_k_max", "eta_star", "friction_solver", "kelvin_voigt_stress", "load",
+           "estimate_k_max", "eta_star", "expression", "interpolate", "scalar_dg0", "scalar_p1",
+           "tensor_dg0", "vector_p1", "friction_solver", "kelvin_voigt_stress", "load",
            "memory_stress", "normal_compliance_pressure", "normal_compliance_term",
            "positive_part", "thesis_law", "viscous_stress", "von_mises"]
 

@@ -314,6 +314,20 @@ def _check_finite(args):
                 raise InputError(f"--{name.replace('_', '-')} must be a finite number, got {v}")
 
 
+def _load_plugins():
+    """Import the modules named in DAMAGE_DOLFINX_PLUGINS (comma-separated): they may register
+    models (damage_dolfinx.register_model), friction solvers or case sources before the run."""
+    import importlib
+    from damage_dolfinx.parameters import InputError
+    for name in filter(None, (n.strip() for n in os.environ.get("DAMAGE_DOLFINX_PLUGINS",
+                                                                  "").split(","))):
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            raise InputError(f"DAMAGE_DOLFINX_PLUGINS names {name!r}, which cannot be "
+                             f"imported: {exc}") from None
+
+
 def main(argv=None):
     """The command; every rank returns the same exit status (runtime/collective.py: an
     exception on one rank only becomes one decided outcome, or ends the job)."""
@@ -368,7 +382,8 @@ def _main(argv, comm, given):
 
 def _say(comm, text):
     if comm.rank == 0:
-        print(text, file=sys.stderr, flush=True)
+        from damage_dolfinx.errors import for_command_line
+        print(for_command_line(text), file=sys.stderr, flush=True)
 
 
 def _command(argv, comm, given):
@@ -378,6 +393,7 @@ def _command(argv, comm, given):
     given.update(_petsc_options(extra, parser, args.command))
     _check_finite(args)
     _check_petsc_values(given)
+    _load_plugins()
     if args.command != "list":
         from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
         import_gmsh_keeping_sigint()

@@ -111,8 +111,12 @@ def create_vector(L_form) -> PETSc.Vec:
         return fem.petsc.create_vector(fem.extract_function_spaces(L_form))
 
 
-def create_matrix(a_form) -> PETSc.Mat:
-    return fem.petsc.create_matrix(a_form)
+def create_matrix(a_form, mat_type=None) -> PETSc.Mat:
+    """The matrix of a bilinear form; ``mat_type`` e.g. "baij" (the second positional argument
+    is mat_type up to 0.9 and kind from 0.10 on: the same strings)."""
+    if mat_type is None:
+        return fem.petsc.create_matrix(a_form)
+    return fem.petsc.create_matrix(a_form, mat_type)
 
 
 def assemble_vector(b, L_form):

@@ -35,7 +35,13 @@ def _short(text: str) -> str:
     """The departure itself: the entry's first clause (before the thesis reference, the
     evidence or the reasons)."""
     what = re.split(r" \([^()]*\blines? \d|\. |; |: |, the ", text, maxsplit=1)[0]
-    return what.strip()[:160]
+    depth, cut = 0, len(what)
+    for i, ch in enumerate(what):  # an unclosed bracket: cut before it
+        if ch in "({":
+            depth, cut = depth + 1, (i if depth == 0 else cut)
+        elif ch in ")}":
+            depth, cut = depth - 1, (len(what) if depth == 1 else cut)
+    return what[:cut].strip()[:160]
 
 
 def _basis(kind: str) -> str:

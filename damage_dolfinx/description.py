@@ -169,7 +169,7 @@ class Example:
                              f"{mesh_path_problem(Path(mesh_file)) or 'is not a file'}")
         if time.num_steps > MAX_STEPS and not allow_long:
             raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
-                             f"{MAX_STEPS:.0e}; choose a larger k, or --allow-long")
+                             f"{MAX_STEPS:.0e}; choose a larger k, or allow_long=True")
         if mesh_file is not None and self.dim != 2:
             raise InputError(f"--mesh reads 2-D gmsh meshes; example {self.id} is {self.dim}-D")
         if mesh_file is None and not self.own:

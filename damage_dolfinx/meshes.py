@@ -3,7 +3,9 @@
 Every model reads the parts of the boundary from *facet tags* (integers on the boundary facets):
 in gmsh, *physical curves* (2-D) or *physical surfaces* (3-D); the cells must belong to a
 physical surface (2-D) or volume (3-D). Which tag plays which role (clamped, loaded, in contact)
-is said by :class:`~damage_dolfinx.Problem`'s ``boundaries``. The thesis catalogue and
+is said by :class:`~damage_dolfinx.Problem`'s ``boundaries``, by tag number or by the gmsh
+physical name of the group (``boundaries={"clamped": "left", "tresca": ["bottom", 7]}``; a name
+the mesh does not have is refused with the names it has). The thesis catalogue and
 ``damage-dolfinx run ID --mesh FILE`` use the fixed convention
 
     1 = Gamma_D (clamped),  2 = Gamma_N (traction),  3 = Gamma_C (contact).
@@ -46,6 +48,17 @@ def _check_model(dim):
     return check
 
 
+def _facet_names(gmsh) -> dict:
+    """{physical name: tag} of the physical groups one dimension below the model's (rank 0)."""
+    d = gmsh.model.getDimension()
+    names = {}
+    for gd, tag in gmsh.model.getPhysicalGroups(d - 1):
+        name = gmsh.model.getPhysicalName(gd, tag)
+        if name:
+            names[name] = int(tag)
+    return names
+
+
 def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     """A gmsh ``.msh`` file as a :class:`~damage_dolfinx.geometries.Geometry` (mesh and facet
     tags), read on rank 0 and distributed over ``comm``. ``dim``: the dimension the problem
@@ -58,11 +71,18 @@ def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     if path.stat().st_size == 0:
         raise InputError(f"mesh file {str(path)!r} is empty")
     from damage_dolfinx import compat
+    names = {}
+
+    def check(gmsh):  # on rank 0, the file's model loaded: also its physical names
+        error = _check_model(dim)(gmsh)
+        if error is None:
+            names.update(_facet_names(gmsh))
+        return error
     try:
-        msh, _, facet_tags = compat.read_msh(comm, path, check=_check_model(dim))
+        msh, _, facet_tags = compat.read_msh(comm, path, check=check)
     except ValueError as exc:
         raise InputError(f"mesh file {str(path)!r}: {exc}") from None
-    return _geometry(msh, facet_tags, f"gmsh file {path.name}")
+    return _geometry(msh, facet_tags, f"gmsh file {path.name}", comm.bcast(names, root=0))
 
 
 def from_gmsh(model=None, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
@@ -77,8 +97,9 @@ def from_gmsh(model=None, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     if error:
         raise InputError(f"gmsh model: {error}")
     d = comm.bcast(model.getDimension() if comm.rank == 0 else None, root=0)
+    names = comm.bcast(_facet_names(gmsh) if comm.rank == 0 else None, root=0)
     msh, _, facet_tags = compat.model_to_mesh(model, comm, 0, gdim=d)
-    return _geometry(msh, facet_tags, "gmsh model")
+    return _geometry(msh, facet_tags, "gmsh model", names)
 
 
 def as_geometry(mesh, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
@@ -94,7 +115,7 @@ def as_geometry(mesh, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
                      f"function (comm, n) -> one of these; got {type(mesh).__name__}")
 
 
-def _geometry(msh, facet_tags, description) -> Geometry:
+def _geometry(msh, facet_tags, description, names=None) -> Geometry:
     tdim = msh.topology.dim
     num = msh.topology.index_map(tdim).size_local
     h = 0.0
@@ -102,7 +123,7 @@ def _geometry(msh, facet_tags, description) -> Geometry:
         from damage_dolfinx import compat
         h = float(np.max(compat.cell_diameters(msh, np.arange(num))))
     h = msh.comm.allreduce(h, op=MPI.MAX)
-    return Geometry(msh, facet_tags, h=h, description=description)
+    return Geometry(msh, facet_tags, h=h, description=description, names=names or None)
 
 
 def tag_counts(geometry: Geometry) -> dict:
@@ -128,7 +149,7 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
     """The geometry with its facet tags renamed to the roles the models read (1 clamped,
     2 traction, 3 contact), from ``boundaries`` = {role: tag or tags}; None keeps the tags as
     they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty.
-    ``model``: the model class, whose ``contact_roles`` are the contact roles allowed."""
+    ``model``: the model class, whose ``boundary_roles()`` are the roles allowed."""
     from damage_dolfinx import compat
     from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION
     counts = tag_counts(geometry)
@@ -138,22 +159,45 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
             raise InputError(f"{where}: the {what} tag {tag} is missing or empty")
     if boundaries is None:
         return geometry
-    allowed = ("clamped", "traction") + (model.contact_roles if model else CONTACT_ROLES)
-    internal = {"clamped": CLAMPED, "traction": TRACTION}
+    internal = model.boundary_roles() if model else \
+        {"clamped": CLAMPED, "traction": TRACTION, **{r: CONTACT for r in CONTACT_ROLES}}
+    allowed = tuple(internal)
     mapping = {}
     for role, tags in boundaries.items():
         if role not in allowed:
             raise InputError(f"boundary role {role!r} is not one of model {model.id}'s: "
                              f"{', '.join(allowed)}")
-        for tag in ([tags] if isinstance(tags, (int, np.integer)) else list(tags)):
+        for tag in _tag_numbers(geometry, role, tags, where):
             if not counts.get(int(tag)):
                 raise InputError(f"{where}: the {role} tag {int(tag)} is missing or empty "
                                  f"(tags present: {sorted(counts) or 'none'})")
             if int(tag) in mapping:
                 raise InputError(f"facet tag {int(tag)} is given two roles")
-            mapping[int(tag)] = internal.get(role, CONTACT)
+            mapping[int(tag)] = internal[role]
     ft = geometry.facet_tags
     keep = np.isin(ft.values, list(mapping))
     values = np.array([mapping[int(v)] for v in ft.values[keep]], dtype=np.int32)
     tags = compat.meshtags(geometry.mesh, geometry.mesh.topology.dim - 1, ft.indices[keep], values)
-    return Geometry(geometry.mesh, tags, geometry.h, geometry.grid, geometry.description)
+    return Geometry(geometry.mesh, tags, geometry.h, geometry.grid, geometry.description,
+                    geometry.names)
+
+
+def _tag_numbers(geometry, role, tags, where) -> list:
+    """The tag numbers of ``boundaries[role]``: a tag, a gmsh physical name, or a list of
+    them; a name the mesh does not have is refused with the names it has."""
+    items = [tags] if isinstance(tags, (int, np.integer, str)) else list(tags)
+    names = geometry.names or {}
+    numbers = []
+    for item in items:
+        if isinstance(item, str):
+            if item not in names:
+                present = ", ".join(repr(n) for n in sorted(names)) or "none (the mesh has no " \
+                    "physical names: give tag numbers)"
+                raise InputError(f"{where}: the {role} boundary {item!r} is not a physical "
+                                 f"name of the mesh; names present: {present}")
+            item = names[item]
+        if isinstance(item, bool) or not isinstance(item, (int, np.integer)):
+            raise InputError(f"boundaries[{role!r}]: a tag number, a gmsh physical name or a list "
+                             f"of them, got {item!r}")
+        numbers.append(int(item))
+    return numbers

@@ -44,8 +44,9 @@ class Problem:
         T: final time.
         k: time step (None: the largest below 0.8 k_max and T/100 that divides T; for a
             dynamic model k must be given). A k above the scheme's stability limit k_max is
-            refused unless ``allow_unstable``.
-        boundaries: ``{role: tag or [tags]}``; roles ``clamped`` (u = 0), ``traction``
+            refused unless ``allow_unstable``; :meth:`k_max` gives the limit before the run.
+        boundaries: ``{role: tag or [tags]}``, a tag a number or a gmsh physical name
+            (``{"clamped": "left"}``, a mesh read from gmsh); roles ``clamped`` (u = 0), ``traction``
             (the traction acts there), and one of the model's ``contact_roles``: ``bilateral``
             (u.nu = 0), ``tresca`` (bilateral contact, Tresca friction bound ``g_fric``),
             ``coulomb`` (simplified Coulomb, normal stress ``S_n``, bound ``mu_f |S_n|``),
@@ -85,6 +86,12 @@ class Problem:
     builders: dict = field(default_factory=dict)
     allow_unstable: bool = False
 
+    def k_max(self, comm=None) -> float:
+        """The time-step limit of the scheme's explicit terms for this mesh and data (inf: none);
+        a k above it is refused. Collective (runtime/limits.py)."""
+        from damage_dolfinx.runtime.limits import k_max
+        return k_max(self, comm) if comm is not None else k_max(self)
+
     def parameters(self) -> ModelParameters:
         """The run's data: the model's defaults with ``params`` applied (validated)."""
         from damage_dolfinx.models.registry import model, validate
@@ -123,8 +130,8 @@ class Problem:
         k = self.k
         if k is None:
             if info.dynamic:
-                raise InputError(f"model {info.id} needs a time step k (its limit k_max depends "
-                                 "on the mesh; a k above it is refused with its value)")
+                raise InputError(f"model {info.id} needs a time step k below its limit k_max, "
+                                 "which depends on the mesh and data: problem.k_max() gives it")
             k = min(self.T / 100.0, 0.8 * info.k_max(params))
             k = self.T / math.ceil(self.T / k * (1 - 1e-12))
         family = callable(self.mesh) and not isinstance(self.mesh, tuple)

@@ -14,7 +14,8 @@ def _named(problem):
 
 
 def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD) -> dict:
+        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD,
+        on_step=None) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
     ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
     ``out/summary.json``).
@@ -26,8 +27,23 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     larger ``T`` continues a completed run); a folder that already holds a run is refused
     unless ``restart`` or ``overwrite``. SIGTERM/SIGINT stop the run at the end of a step with a
     checkpoint. Under ``mpirun`` every rank calls it; only rank 0 prints. ``n``, ``k``, ``T``
-    override the problem's own. Bad input raises :class:`~damage_dolfinx.InputError` before any
-    work; a solver that fails raises ConvergenceError after marking the summary "failed".
+    override the problem's own. ``fields.xdmf`` is one time series from t = 0 to the last step
+    whatever restarts happened; :func:`~damage_dolfinx.read_run` reads the folder back.
+    ``on_step(step)``: called after the initial state and after every step with the
+    :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
+    the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
+
+    Raises (all importable from ``damage_dolfinx``; damage_dolfinx.errors):
+
+    * :class:`~damage_dolfinx.InputError`: bad input, refused before any work (one line; a
+      folder holding a run without ``restart=True`` or ``overwrite=True``, a k above
+      ``problem.k_max()``, an unknown boundary name, ...);
+    * :class:`~damage_dolfinx.ConvergenceError`: a solver did not converge or a field became
+      NaN/inf or left [zeta*, 1]; summary.json says "failed", the finished steps stay;
+    * :class:`~damage_dolfinx.OutputError`: an output could not be written (full disk, I/O
+      error); summary.json says "failed" where space allows;
+    * :class:`~damage_dolfinx.RunInterrupted`: SIGTERM, SIGINT or SIGUSR1 stopped the run at the
+      end of a step after a checkpoint (summary.json "interrupted"; ``restart=True`` goes on).
     """
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.runner import run as _run
@@ -40,7 +56,29 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
             "checkpoint_every", "progress", "figures"))
         return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
                     checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                    comm=comm)
+                    comm=comm, on_step=on_step)
+
+
+def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
+          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD):
+    """The run of :func:`run` (the same arguments, the same run folder), step by step::
+
+        for step in dd.steps(problem, "results/mine"):
+            R = step.contact_resultant()       # int_{Gamma_C} p nu ds, every rank
+            if R is not None and abs(R[1]) > 2.0:
+                break                          # the run stops here: status "stopped"
+
+    Each ``step`` (:class:`~damage_dolfinx.runtime.runner.Step`, after the initial state and
+    after every step) has ``n``, ``t``, the model and its live Functions ``u``, ``zeta``, ``v``
+    (None where the scheme has none), ``contact_pressure`` (UFL, None without normal contact),
+    ``contact_resultant()`` and the ``summary`` so far. Leaving the loop stops the run at that
+    step with its outputs and a checkpoint (``restart=True`` continues it). Under MPI every
+    rank iterates and must stop at the same step (decide from collective values, as
+    ``contact_resultant()`` is). Bad input raises InputError here, before any work."""
+    from damage_dolfinx.runtime.loop import Run
+    return Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
+                       overwrite=overwrite, checkpoint_every=checkpoint_every,
+                       progress=progress, figures=figures, comm=comm).steps()
 
 
 def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,

@@ -86,7 +86,17 @@ history = comm.bcast(history, root=0)
 t, u1, tau = history["t"], history["probe_u1"], np.abs(history["probe_sigma_tau"])
 excess = max(0.0, tau.max() / g - 1)
 at_bound = abs(tau[-1] / g - 1)
-checks = [("friction_bound", excess, 1e-6), ("slip_at_bound", at_bound, 1e-3)]
+# The contact outputs of the whole foundation (``history.csv``): where the block slides the
+# friction traction is at the bound, so the friction resultant is :math:`-g` times the
+# sliding length (``slip_length``; here all of :math:`\Gamma_C` but the node held by the
+# clamp), and the foundation pushes no net load in :math:`x` beyond it.
+friction, sliding = history["friction_force"][-1], history["slip_length"][-1]
+slip_balance = abs(friction / (-g * sliding) - 1)
+checks = [("friction_bound", excess, 1e-6), ("slip_at_bound", at_bound, 1e-3),
+          ("friction_resultant", slip_balance, 1e-6)]
+if comm.rank == 0:
+    print(f"friction resultant at T: {friction:.10g} (-g x sliding length "
+          f"{sliding:g} = {-g * sliding:g})")
 if comm.rank == 0:
     print(f"max |sigma_tau| = {tau.max():.6f}, final |sigma_tau| = {tau[-1]:.6f} (g = {g:g})")
     for name, value, tolerance in checks:

@@ -138,6 +138,21 @@ if comm.rank == 0:
 assert verdict == "PASS" and bound == "PASS", (deviation, outside)
 
 # %%
+# The reactions of the two symmetry planes (``contact_force_x`` in ``history.csv``: the
+# resultant of the bilateral contact, a contact output of every model) balance the load
+# :math:`t_0 \cdot 1` on the end :math:`x = 4` (height 1) at the last step: the plate is at
+# rest.
+
+run = dd.read_run(out)
+resultant = run.history["contact_force_x"][-1]
+balance = abs(resultant / (t0 * 1.0) + 1)
+if comm.rank == 0:
+    print(f"contact resultant at T: {resultant:.10g} (load: {-t0:g})")
+    print(f"PHYSICS_CHECK contact_balance {balance:.3e} 1e-08 "
+          f"{'PASS' if balance <= 1e-8 else 'FAIL'}")
+assert balance <= 1e-8, balance
+
+# %%
 # Figure
 # ------
 # The damage :math:`1 - \zeta` at :math:`t = T` on the quarter plate: it is largest at the

@@ -100,7 +100,15 @@ area = length * height
 stress_ratio = history["stress_Q"][1:] / (S * np.sqrt(area))
 eps11 = history["eps_u_L2"] / np.sqrt((1 + nu**2) * area)
 creep = S / E * (1 + np.concatenate([[0.0], np.cumsum(k * (1 - zeta[1:-1]))]))
-checks = [("equilibrium", float(np.max(np.abs(stress_ratio - 1))), 1e-8),
+# The contact force the foundations exert (history column ``contact_force_x``, the resultant
+# of the friction and of the bilateral reactions on :math:`\Gamma_C`) balances the pull
+# :math:`S \cdot` height at every step: the body is at rest (quasistatic).
+balance = float(np.max(np.abs(history["contact_force_x"][1:] / (S * height) + 1)))
+if comm.rank == 0:
+    print(f"contact resultant at T: {history['contact_force_x'][-1]:.10g} "
+          f"(load -S height = {-S * height:g})")
+checks = [("contact_balance", balance, 1e-8),
+          ("equilibrium", float(np.max(np.abs(stress_ratio - 1))), 1e-8),
           ("uniform_damage", float(np.max(history["zeta_max"] - history["zeta_min"])), 1e-8),
           ("creep_closed_form", float(np.max(np.abs(eps11[1:] / creep - 1))), 1e-6)]
 if comm.rank == 0:

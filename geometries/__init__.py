@@ -25,6 +25,7 @@ class Geometry:
     h: float                           # characteristic (maximal) cell diameter
     grid: Optional[StructuredGrid] = None
     description: str = ""
+    names: Optional[dict] = None       # gmsh physical names of the facet tags: {name: tag}
 
 
 _gmsh_ready = False

@@ -27,8 +27,8 @@ from reproduction.records import (REPO, _bridge, _friction_cpu, _performance, _s
 from reproduction.sources import (Figures, _bridge_summary, _convergence_png, _fidelity, _load_json,
                              _study_folder)
 from reproduction.text import assumption, example_ref
-from reproduction.verdicts import (CLASSES, category, headline, known_differences, summary_table,
-                              table_rows)
+from reproduction.classes import QUICK, Evidence, classify, counts as class_counts, headline
+from reproduction.verdicts import CLASSES, category, known_differences, summary_table, table_rows
 
 SECTION_TITLES = {
     "2.1": "Section 2.1: quasistatic elastic body with damage",
@@ -43,39 +43,30 @@ SECTION_TITLES = {
 FOLDER = "report"
 
 
-def quick_difference(command: str, ex) -> str:
-    """What a quick run changes against the full run of ``ex`` (mesh, time step, final time),
-    read from its command."""
+def quick_difference(command: str, ex, thesis_run: str = "") -> str:
+    """What a quick run is, beside the thesis's figure: its mesh, time step and final time read
+    from its command, then the thesis figure's own mesh and step where the thesis states them."""
     opts = dict(re.findall(r"--(n|h|k|T) (\S+)", command))
     parts = []
-    if "n" in opts and ex.n is not None and int(opts["n"]) != ex.n:
-        parts.append(f"mesh n = {opts['n']} instead of {ex.n}")
-    if "h" in opts and ex.h is not None and float(opts["h"]) != ex.h:
-        parts.append(f"mesh size h = {opts['h']} instead of {ex.h:g}")
-    if "k" in opts and float(opts["k"]) != ex.k:
-        parts.append(f"time step k = {opts['k']} instead of {ex.k:g}")
+    if "n" in opts:
+        parts.append(f"n = {opts['n']}")
+    if "h" in opts:
+        parts.append(f"h = {opts['h']}")
+    parts.append(f"k = {opts.get('k', f'{ex.k:g}')}")
     if "T" in opts and float(opts["T"]) != ex.T:
         parts.append(f"stops at t = {opts['T']} of T = {ex.T:g}")
-    return ", ".join(parts) or "the full run's data"
+    thesis = (f"the thesis's figure: {thesis_run}" if thesis_run else
+              "the thesis does not state its figure's mesh")
+    return f"quick run on {', '.join(parts)} ({thesis})"
 
 
-def departures(catalogue, example_id, reading):
-    """The departures from the stated data (``R<n>`` assumptions) of an example under a
-    reading, as the catalogue describes them."""
-    ex = catalogue.get(example_id)
-    if ex is None or not reading or reading == "literal":
-        return []
-    return [a for a in (ex.literal or ex).with_reading(reading).assumptions if a.startswith("R")]
-
-
-def _setting_verdict(ex):
-    """A setting figure: reproduced, unless its geometry or boundary layout is assumed."""
+def _setting_verdict(ex, quick=False):
+    """A setting figure: drawn as stated, unless its geometry or boundary layout is assumed."""
     layout = [a for a in ex.literal.assumptions if re.match(
         r"(?:[\d.]+/)?G\d+[\w/]*:\s*(?:Gamma_[DNC] =|Omega =|geometry|cantilever|semicircular)", a)]
-    if not layout:
-        return "reproduced", "the setting as stated in the text"
-    return ("setting assumed: " + "; ".join(assumption(a).removeprefix("assumed: ")
-                                            for a in layout)), "our assumed layout"
+    verdict = classify(Evidence(kind="setting", quick=quick, layout_assumed="; ".join(
+        assumption(a).removeprefix("assumed: ") for a in layout)))
+    return verdict, ("our assumed layout" if layout else "the setting as stated in the text")
 
 
 def build(results: Path) -> Path:
@@ -100,11 +91,9 @@ def build(results: Path) -> Path:
     readings = REPO / "benchmarks" / "readings.md"
 
     # ---- verdicts of every thesis figure and table (rows of the summary, thesis order)
-    for t in fidelity["tables"]:  # the departures as the catalogue describes them
-        if t.get("departures"):
-            t["departures"] = departures(catalogue, t["example"].split()[0], t.get("reading"))
     rows = table_rows(fidelity, results, _study_folder, _load_json, _sort_key)
     table_verdicts = {t["table"]: r["verdict"] for t, r in zip(fidelity["tables"], rows)}
+    by_number = {t["table"]: t for t in fidelity["tables"]}
     conv_table = {"2.11": "2.4", "2.15": "2.5", "2.23": "2.6", "3.2": "3.1"}
     figure_blocks = {}
     for fig in THESIS_FIGURES:
@@ -116,6 +105,10 @@ def build(results: Path) -> Path:
             paths = [(p, "study") for p in (_convergence_png(results, fig.example, v)
                                             for v in variants) if p]
             if fig.number in conv_table:
+                numbers = ("2.6", "2.7") if fig.number == "2.23" else (conv_table[fig.number],)
+                beside = [_thesis_beside_ours(results, by_number.get(n)) for n in numbers]
+                if all(beside):  # the thesis's values beside ours (the study's own plot else)
+                    paths = [(b, paths[0][1] if paths else "study") for b in beside]
                 verdict = table_verdicts.get(conv_table[fig.number], "not comparable")
                 got = f"as Table {conv_table[fig.number]}"
                 if fig.number == "2.23":
@@ -124,37 +117,40 @@ def build(results: Path) -> Path:
                         min(both, key=lambda v: -CLASSES.index(category(v)))
                     got = "as Tables 2.6 (Tresca) and 2.7 (Coulomb)"
             else:
-                verdict, got = ("not comparable: our convergence plot alone (see the table "
-                                "row)"), "our convergence plot"
+                verdict, got = classify(Evidence(
+                    statement=False, no_statement="the thesis's table is not available to this "
+                    "report; our convergence plot alone (see the table row)")), "our convergence plot"
         elif fig.kind == "setting":
-            verdict, got = _setting_verdict(ex)
+            verdict, got = _setting_verdict(ex, quick=bool(paths) and paths[0][1] == "quick")
         elif fig.kind == "assumed-setting":
-            verdict, got = ("setting assumed: the thesis shows a sketch without dimensions; "
-                            "ours is an assumed geometry"), "our assumed geometry"
+            verdict, got = classify(Evidence(
+                kind="setting", quick=bool(paths) and paths[0][1] == "quick",
+                layout_assumed="the thesis shows a sketch without dimensions; ours is an assumed "
+                "geometry")), "our assumed geometry"
         else:
             context = run_context(figs.run_folder(found[0][3]) if found and found[0] else None)
             context["T_full"] = ex.T if ex else None
             command = found[0][3].get("command", "") if found and found[0] else ""
             stop = re.search(r"--T (\S+)", command)
             context["T_run"] = float(stop.group(1)) if stop else None
-            context["departures"] = departures(catalogue, fig.example, context.get("reading"))
+            context["quick"] = bool(found and found[0]) and found[0][1] == "quick"
             if bridge and fig.example == "2.1-ex3":
                 context.update(hinges=bridge.get("n_mechanism_hinges", bridge.get("n_hinges")),
                                failure_load_kN=bridge.get("failure_load_kN"))
             related = [r[2] if r else None for r in (figs.find(f) for f in fig.related)]
             verdict, got, _ = judge(fig, [f[2] if f else None for f in found], related, context)
         if not paths:
-            verdict, got = "not comparable: not produced (run `make figures`)", "-"
+            verdict, got = classify(Evidence(missing="not produced (run `make figures`)")), "-"
         quick = any(mode == "quick" for _, mode in paths) and bool(found and found[0])
         if quick and ex:
-            got += f" [quick run: {quick_difference(found[0][3].get('command', ''), ex)}]"
+            got += (f" [{quick_difference(found[0][3].get('command', ''), ex, fig.thesis_run)}]")
         rows.append(dict(key=_sort_key(fig.number, 1), item=f"Figure {fig.number}",
                          anchor=fig.anchor, example=fig.example,
                          shows=f"{fig.shows} ({example_ref(fig.example)})", got=got,
                          verdict=verdict))
         figure_blocks.setdefault(fig.example, []).append((fig, paths, got, verdict, quick))
     rows.sort(key=lambda r: r["key"])
-    counts = {c: sum(category(r["verdict"]) == c for r in rows) for c in CLASSES}
+    counts = class_counts(r["verdict"] for r in rows)
     _title(doc, figs, counts, len(rows))
     _contents(doc, readings)
     summary_table(doc, rows, fidelity)
@@ -177,25 +173,41 @@ def build(results: Path) -> Path:
     return page
 
 
+def _thesis_beside_ours(results, entry):
+    """The thesis's table values beside our errors (reproduction/plots.py), or None."""
+    if not entry or "ratio_median" not in entry:
+        return None
+    from reproduction.plots import thesis_beside_ours
+    return thesis_beside_ours(entry, results / "fidelity" / f"table_{entry['table'].replace('.', '_')}.png",
+                              f"Table {entry['table']}: thesis (open, dashed) and ours (filled), "
+                              f"{entry['study']}")
+
+
 def _title(doc, figs, counts, total):
     fig_modes = ", ".join(f"{index['mode']} figure runs on {index['mpi_size']} MPI ranks "
                           f"({index.get('wall_time_s', '?')} s)" for _, index, _ in figs.sources[:1])
-    quick = figs.sources and figs.sources[0][2] == "quick"
+    quick = bool(figs.sources) and figs.sources[0][2] == "quick"
+    preview = ("<p style=\"background:#fff3cd;border:1px solid #e0a800;padding:6px\"><b>Preview: judged on coarse quick runs</b> (`make figures-"
+               "quick`), not on the thesis's resolution. Every verdict judged on a quick run ends "
+               "in “(quick)”; run `make figures` for the verdicts a reviewer can sign.</p>"
+               if counts.get("quick") else "")
     lines = "".join(f'<li class="{c}">{counts[c]} {html.escape(c)}</li>' for c in CLASSES)
     doc.raw(f'<header class="title"><h1>damage-dolfinx: reproduction of M. Campo (2007)</h1>'
+            + preview.replace("`", "") +
             f"<p>M. Campo, <i>Numerical analysis and simulation of quasistatic and dynamic "
             f"contact problems with damage</i>, PhD thesis, Universidade de Santiago de "
             f"Compostela, 2007: every thesis figure and error table recomputed with DOLFINx and "
             f"set beside the thesis. Thesis references give the thesis's section, page and "
             f"example.<br>Generated {time.strftime('%Y-%m-%d %H:%M')} by <code>make report</code>; "
             f"figures: {html.escape(fig_modes or 'none yet (run make figures)')}"
-            + (" — <b>coarse quick runs</b>: each caption says what differs from the full run"
-               if quick else "") + ".</p>"
-            f'<p><b>Verdicts of the {total} thesis tables and figures:</b></p>'
+            + (" (coarse quick runs)" if quick else "") + ".</p>"
+            f"<p><b>What the verdicts rest on:</b> {html.escape(headline(counts))}.</p>"
             f'<ul class="counts">{lines}</ul></header>',
-            f"# damage-dolfinx: reproduction of M. Campo (2007)\n\nGenerated "
-            f"{time.strftime('%Y-%m-%d %H:%M')}; figures: {fig_modes or 'none'}."
-            f"\n\n**{headline(counts)}** (of {total}).")
+            f"# damage-dolfinx: reproduction of M. Campo (2007)\n\n"
+            + ("**Preview: judged on coarse quick runs, not on the thesis's resolution; every "
+               "verdict judged on a quick run ends in (quick).**\n\n" if counts.get("quick") else "")
+            + f"Generated {time.strftime('%Y-%m-%d %H:%M')}; figures: {fig_modes or 'none'}."
+            f"\n\n**{headline(counts)}**.")
 
 
 def _contents(doc, readings):
@@ -225,8 +237,7 @@ def _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_comma
             for mode, run in figs.runs(ex.id):
                 doc.para(f"Run{' (' + run['variant'] + ')' if run['variant'] else ''}: "
                          f"`{run['command']}` ({_status(run)}, {run['wall_time_s']} s)"
-                         + (f"; quick run: {quick_difference(run['command'], ex)}"
-                            if mode == "quick" else ""))
+                         + (f"; {quick_difference(run['command'], ex)}" if mode == "quick" else ""))
             thesis_files = set()
             for fig, paths, got, verdict, quick in figure_blocks.get(ex.id, []):
                 thesis_files.update(fig.files)
@@ -254,8 +265,8 @@ def _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_comma
             if ex.id == "2.2-ex1":
                 _friction_cpu(doc)
             doc.para("**Assumptions**: *assumed* = a value or layout the thesis does not give; "
-                     "*reading* = a departure from the stated data (fitted, or taken from "
-                     "another place of the text).")
+                     "*reading* and *departure* = a departure from the stated data (its basis "
+                     "in brackets: supported by the text, fitted, or against the text).")
             doc.items(assumption(a) for a in ex.assumptions)
 
 
@@ -286,7 +297,10 @@ def _fidelity_table(doc, t):
         cells = ""
         for k in ks:
             c = rows[n].get(float(k), {})
-            if "ratio" in c:
+            if "ratio" in c and "excluded" in c:
+                cells += (f'<td class="ratio"><b>({c["ratio"]:.3g})</b><small>left out: '
+                          f'{c["thesis"]:.4g} / {c["ours"]:.4g}</small></td>')
+            elif "ratio" in c:
                 cls = "good" if 0.5 <= c["ratio"] <= 2 else "bad"
                 cells += (f'<td class="ratio {cls}"><b>{c["ratio"]:.3g}</b><small>'
                           f'{c["thesis"]:.4g} / {c["ours"]:.4g}</small></td>')

@@ -3,17 +3,8 @@
 A figure's data are the ``.panel.npz`` post.plot_fields saves beside it (undeformed and deformed
 vertex coordinates, stress and damage per vertex) and its run's ``history.csv`` and
 ``summary.json``. Each check of reproduction.figures.THESIS_FIGURES tests the quantity the quoted
-thesis sentence is about; :func:`judge` grades the figure (report_verdicts.CLASSES):
-
-* *not visible in this figure* when the statement is about the damage and the damage is one
-  colour on the thesis's fixed scale [zeta*, 1] (range below 25 % of it; the figure then adds a
-  panel on the field's own range) or did not develop at all;
-* *differs* when a check fails (the failed checks are named);
-* *reproduced under a reading* when every check holds on a run that departs from the stated
-  data (each departure named, fitted or taken from the text);
-* *not comparable* when nothing the sentence says can be measured, or the run stops before the
-  time the sentence is about (quick runs);
-* *reproduced* otherwise.
+thesis sentence is about and quotes our number; :func:`evidence` gathers what the figure's
+data show and :func:`judge` grades it by the rules of reproduction.classes (one rule per class).
 """
 from __future__ import annotations
 
@@ -47,6 +38,9 @@ def fields(npz) -> dict:
         out.setdefault("disp", (xy - base) / amp)
         key = "zeta" if p.get("name") == "zeta" or "zeta" in p.get("label", "") else "stress"
         out.setdefault(key, vals)
+        if key == "stress":
+            out.setdefault("stress_name", "von Mises strain" if "strain" in p.get("label", "")
+                           or "strain" in p.get("name", "") else "von Mises stress")
     return out
 
 
@@ -81,7 +75,8 @@ def measure(npz, related=()) -> dict:
     """Numbers the checks need, from one figure's data (and its related figures' data)."""
     f = fields(npz)
     base, meta = f["base"], f["meta"]
-    m = {"amplification": meta.get("amplification"), "zeta_star": meta.get("zeta_star") or 0.01}
+    m = {"amplification": meta.get("amplification"), "zeta_star": meta.get("zeta_star") or 0.01,
+         "stress_name": f.get("stress_name", "von Mises stress")}
     d = np.linalg.norm(f["disp"], axis=1)
     dmax = float(d.max()) or 1.0
     rel = (base - base.min(0)) / np.where(np.ptp(base, 0) > 0, np.ptp(base, 0), 1)
@@ -148,10 +143,9 @@ CHECKS = {  # name: (what is tested, predicate(measures, context) -> bool or Non
                                lambda m, c: m["u_top"] < 0.1 * max(m["u_bottom"], 1e-30)),
     "bottom_fixed": ("contact boundary (bottom) moves < 5 % of the largest displacement",
                      lambda m, c: m["u_bottom"] < 0.05),
-    "readable": ("the drawn (amplified) displacement stays below the body size, as in the "
-                 "thesis's figure", lambda m, c: m["u_max"] * (m["amplification"] or 1) < m["size"]),
-    "no_penetration": ("penetration into the obstacle (rms over the contact boundary, final "
-                       "time) below 1 % of the largest displacement",
+    "no_penetration": ("penetration into the obstacle below 1 % of the largest displacement "
+                       "(rms over the contact boundary at the final time, or the largest over "
+                       "the run where the run records that)",
                        lambda m, c: c["penetration_last"] <= 0.01 * m["u_max"]),
     "stressed": ("stress not zero at the final time", lambda m, c: m["stress_max"] > 0),
     "displaced": ("the body not back in its initial position at the final time (||u||_L2 above "
@@ -194,7 +188,9 @@ def run_context(folder) -> dict:
     try:
         summary = json.loads((folder / "summary.json").read_text())
         c["zeta_star"] = float(summary["parameters"]["zeta_star"])
-        c["reading"] = summary.get("reading")
+        c["status"], c["t_final"] = summary.get("status"), summary.get("t_final")
+        from reproduction.classes import record_departures
+        c["departures"] = record_departures(summary)
         with open(folder / "history.csv") as f:
             rows = list(csv.DictReader(f))
         col = lambda name: [float(r[name]) for r in rows if r.get(name)]  # noqa: E731
@@ -203,6 +199,8 @@ def run_context(folder) -> dict:
             c.update(u_L2_first=u[0], u_L2_last=u[-1], u_L2_max=max(u))
         if col("penetration_rms"):
             c["penetration_last"] = col("penetration_rms")[-1]
+        elif summary.get("max_penetration") is not None:  # largest over the run (the wrench)
+            c["penetration_last"] = float(summary["max_penetration"])
         if col("zeta_probe"):
             c["probe_min"] = min(col("zeta_probe"))
         if rows:
@@ -217,69 +215,102 @@ def run_context(folder) -> dict:
     return c
 
 
-def departure(text: str) -> str:
-    """A reading's departure from the stated data, short: 'kappa = 0.003 instead of kappa = 1
-    (fitted)'."""
-    import re
-    m = re.match(r"R\d+ \(([^)]*)\):\s*(.*)", text)
-    if not m:
-        return text
-    kind = m.group(1).split("; ", 1)[-1] if "; " in m.group(1) else "not stated in the text"
-    kind = "fitted" if kind.startswith("FITTED") else kind
-    what = re.split(r" \([^()]*\blines? \d|\. |; |: |, the ", m.group(2), maxsplit=1)[0]
-    return f"{what[:120]} ({kind})"
+#: our number behind each check (quoted in the verdict)
+NUMBERS = {
+    "physical": lambda m, c: f"ζ in [{m['zeta_min']:.3g}, {m['zeta_max']:.3g}]",
+    "localised": lambda m, c: f"{100 * m['area_near_star']:.0f} % of the nodes within 0.09 of ζ*",
+    "min_zeta_lower_right": lambda m, c: f"most damaged at the {quadrant(m['zeta_min_at'])} "
+                                         f"(x = {m['zeta_min_xy'][0]:.2g}, {m['zeta_min_xy'][1]:.2g})",
+    "min_zeta_top_or_lower_right": lambda m, c: NUMBERS["min_zeta_lower_right"](m, c),
+    "min_zeta_left": lambda m, c: NUMBERS["min_zeta_lower_right"](m, c),
+    "damage_at_top_or_bottom": lambda m, c: NUMBERS["min_zeta_lower_right"](m, c),
+    "contact_bands": lambda m, c: f"bands against the rest: stress {m['stress_band_ratio']:.2f}x, "
+                                  f"damage {m['damage_band_ratio']:.2f}x",
+    "colocated": lambda m, c: f"rank correlation {m['rank_stress_damage']:.2f}",
+    "stress_pattern_same": lambda m, c: f"rank correlation {m['pair_rank_stress']:.2f}",
+    "damage_pattern_differs": lambda m, c: f"rank correlation {m['pair_rank_zeta']:.2f}",
+    "top_fixed_bottom_moves": lambda m, c: f"top edge {m['u_top']:.2f}, bottom edge "
+                                           f"{m['u_bottom']:.2f} of max |u|",
+    "bottom_fixed": lambda m, c: f"bottom edge {m['u_bottom']:.2f} of max |u|",
+    "no_penetration": lambda m, c: f"penetration {c['penetration_last']:.2g} m, max |u| "
+                                   f"{m['u_max']:.3g} m",
+    "stressed": lambda m, c: f"max {m.get('stress_name', 'stress')} {m['stress_max']:.3g}",
+    "displaced": lambda m, c: f"||u||_L2 {c['u_L2_last']:.3g} m at the end, largest "
+                              f"{c['u_L2_max']:.3g} m",
+    "position_recovers": lambda m, c: f"||u||_L2 {c['u_L2_first']:.3g} m at t = 0, "
+                                      f"{c['u_L2_last']:.3g} m at the end",
+    "four_hinges": lambda m, c: f"{c['hinges']} mechanism hinges",
+    "probe_reaches_star": lambda m, c: f"min ζ(0, 6) = {c['probe_min']:.3g}",
+    "minimum_at_edges": lambda m, c: "at an edge" if c["last_min_at_edge"] else "not at an edge",
+    "deformation_grows": lambda m, c: f"max |u| {c['u_first']:.4g} m, then {c['u_last']:.4g} m "
+                                      f"({100 * (c['u_last'] / c['u_first'] - 1):+.1f} %)",
+    "damage_increases_strain": lambda m, c: f"max von Mises strain {c['strain_undamaged']:.4g} "
+                                            f"undamaged, {c['strain_damaged']:.4g} damaged "
+                                            f"({100 * (c['strain_damaged'] / c['strain_undamaged'] - 1):+.1f} %)",
+}
 
 
-def judge(fig, npzs, related=(), context=None) -> tuple:
-    """(verdict, what we get, failed checks) of one field figure; the verdict starts with its
-    class (report_verdicts.CLASSES)."""
+def stopped_early(fig, c) -> str:
+    """How a run stops before the time the thesis's statement is about ('' if it does not):
+    a final time cut below the thesis's (quick runs), or a stop before it that is not the event
+    the statement is about (the arch's collapse, ζ reaching ζ*)."""
+    T = c.get("T_full")
+    if not T:
+        return ""
+    if c.get("T_run") is not None and c["T_run"] < 0.999 * T:
+        return f"the run stops at t = {c['T_run']:g} of the thesis's T = {T:g}"
+    status, t_end = c.get("status"), c.get("t_final")
+    if status and status != "completed" and status != fig.event and t_end is not None \
+            and t_end < 0.999 * T:
+        return f"the run stops at t = {t_end:.4g} of the thesis's T = {T:g} ({status})"
+    return ""
+
+
+def evidence(fig, npzs, related=(), context=None):
+    """(Evidence of one field figure, what we get): the checks of the quoted statement measured
+    on the figure's data, the departures of its run, an early stop, what the figure cannot show."""
+    from reproduction.classes import ONE_COLOUR, Evidence
     c = dict(context or {}, **pair_context(fig, npzs))
     first = next((n for n in npzs if n), None)
     m = measure(first, related) if first else {}
-    results = []
+    checks = []
     for name in fig.checks:
         desc, pred = CHECKS[name]
         try:
             ok = bool(pred(m, c))
-        except (KeyError, TypeError, IndexError, ValueError):
-            ok = None
-        results.append((name, desc, ok))
-    got = describe(m, c, fig.checks)
-    measured = [r for r in results if r[2] is not None]
-    if not fig.checks:
-        return "not comparable: no check measures the statement", got or "-", []
-    if not measured:
-        return "not comparable: nothing the statement says is measured", got or "no data", []
+            number = NUMBERS[name](m, c) if name in NUMBERS else ""
+        except (KeyError, TypeError, IndexError, ValueError, ZeroDivisionError):
+            ok, number = None, ""
+        checks.append((desc, ok, number))
     zs = m.get("zeta_star", 0.01)
-    truncated = c.get("T_run") is not None and c.get("T_full") and \
-        c["T_run"] < 0.999 * c["T_full"]
-    stop = (f"the quick run stops at t = {c['T_run']:g} of the thesis's T = {c['T_full']:g}"
-            if truncated else "")
     if fig.about_damage and "zeta_min" in m and 1 - m["zeta_min"] < NO_DAMAGE:
-        return (f"not visible in this figure: no damage has developed (ζ ≥ {m['zeta_min']:.5g} "
-                f"everywhere){'; ' + stop if truncated else ''}: nothing to locate"), got, []
-    if truncated:
-        return f"not comparable: {stop}", got, []
-    failed = [desc for _, desc, ok in measured if not ok]
-    if failed:
-        return ("differs: what the thesis says does not hold in our data: "
-                + "; ".join(failed) + " (measured: see what we get)"), got, failed
-    held = "; ".join(desc for _, desc, _ in measured)
+        checks.append(("damage developed (ζ below 1 - 1e-3 somewhere)", False,
+                       f"ζ ≥ {m['zeta_min']:.5g} everywhere"))
+    invisible = ""
     if "pair_max_dzeta" in m and "damage_pattern_differs" in fig.checks \
-            and m["pair_max_dzeta"] < 0.1 * (1 - zs):
-        return (f"not visible in this figure: the two damage fields differ by at most |Δζ| = "
-                f"{m['pair_max_dzeta']:.2g} on the fixed [{zs:g}, 1] scale (the same colours); "
-                f"the data show: {held}; the panels on each field's own range show the two "
-                f"patterns"), got, []
-    if fig.about_damage and "zeta_min" in m and \
-            m["zeta_max"] - m["zeta_min"] < NARROW_DAMAGE * (1 - zs):
-        return (f"not visible in this figure: on the fixed [{zs:g}, 1] scale the damage (ζ in "
-                f"[{m['zeta_min']:.3g}, {m['zeta_max']:.3g}]) is one colour; the data show: "
-                f"{held}; the added panel on the field's own range shows it"), got, []
-    if c.get("departures"):
-        return ("reproduced under a reading: " + "; ".join(departure(d) for d in c["departures"])
-                ), got, []
-    return "reproduced", got, []
+            and m["pair_max_dzeta"] < ONE_COLOUR * (1 - zs):
+        invisible = (f"the two damage fields differ by at most |Δζ| = {m['pair_max_dzeta']:.2g}"
+                     f" on the fixed [{zs:g}, 1] scale (the same colours)")
+    elif fig.about_damage and "zeta_min" in m and \
+            m["zeta_max"] - m["zeta_min"] < ONE_COLOUR * (1 - zs):
+        invisible = (f"on the fixed [{zs:g}, 1] scale the damage (ζ in [{m['zeta_min']:.3g}, "
+                     f"{m['zeta_max']:.3g}]) is one colour")
+    got = describe(m, c, fig.checks)
+    e = Evidence(kind="result", statement=bool(fig.checks), no_statement=fig.no_statement,
+                 checks=checks, departures=list(c.get("departures") or []),
+                 stopped_early=stopped_early(fig, c), invisible=invisible,
+                 quick=bool(c.get("quick")))
+    if first is None and not c:
+        e.checks = []
+    return e, got or "-"
+
+
+def judge(fig, npzs, related=(), context=None) -> tuple:
+    """(verdict, what we get, failed checks) of one field figure; the verdict starts with its
+    class (reproduction.classes.CLASSES)."""
+    from reproduction.classes import classify
+    e, got = evidence(fig, npzs, related, context)
+    return classify(e), got, [c[0] for c in e.checks if c[1] is False]
 
 
 def describe(m: dict, c: dict, checks=()) -> str:
@@ -292,7 +323,9 @@ def describe(m: dict, c: dict, checks=()) -> str:
                          f"{m['zeta_min_xy'][0]:.2g}, {m['zeta_min_xy'][1]:.2g}), "
                          f"{100 * m['area_near_star']:.0f} % of the nodes within 0.09 of ζ*")
     if "stress_max_at" in m:
-        parts.append(f"max stress {m['stress_max']:.3g} Pa at {quadrant(m['stress_max_at'])}")
+        unit = "" if "strain" in m["stress_name"] else " Pa"
+        parts.append(f"max {m['stress_name']} {m['stress_max']:.3g}{unit} at "
+                     f"{quadrant(m['stress_max_at'])}")
     if "rank_stress_damage" in m and {"colocated", "contact_bands"} & set(checks):
         parts.append(f"rank correlation stress / damage {m['rank_stress_damage']:.2f}")
     if "contact_bands" in checks and "damage_band_ratio" in m:
@@ -302,16 +335,15 @@ def describe(m: dict, c: dict, checks=()) -> str:
         parts.append(f"against Figure 2.4: stress rank correlation {m.get('pair_rank_stress', 0):.2f}, "
                      f"damage rank correlation {m['pair_rank_zeta']:.2f}, max |Δζ| "
                      f"{m['pair_max_dzeta']:.2g}")
-    if "u_max" in m and {"top_fixed_bottom_moves", "bottom_fixed", "readable",
+    if "u_max" in m and {"top_fixed_bottom_moves", "bottom_fixed", "deformation_grows",
                          "no_penetration"} & set(checks):
-        parts.append(f"max |u| = {m['u_max']:.3g} m on a body of size {m['size']:.3g} m, drawn "
-                     f"x{m['amplification']:g} (top edge {m['u_top']:.2f}, bottom edge "
-                     f"{m['u_bottom']:.2f} of max |u|)")
+        parts.append(f"max |u| = {m['u_max']:.3g} m on a body of size {m['size']:.3g} m (top "
+                     f"edge {m['u_top']:.2f}, bottom edge {m['u_bottom']:.2f} of max |u|)")
     if {"position_recovers", "displaced"} & set(checks) and "u_L2_first" in c:
         parts.append(f"||u||_L2 {c['u_L2_first']:.3g} m at t = 0, largest {c['u_L2_max']:.3g} m, "
                      f"{c['u_L2_last']:.3g} m at the final time")
     if "no_penetration" in checks and "penetration_last" in c:
-        parts.append(f"penetration (rms) {c['penetration_last']:.2g} m at the final time")
+        parts.append(f"penetration {c['penetration_last']:.2g} m (rms at the final time, or the largest over the run)")
     for key, label in (("hinges", "mechanism hinges"), ("failure_load_kN", "failure load [kN]"),
                        ("probe_min", "min ζ(0, 6)"), ("u_first", "max |u| first"),
                        ("u_last", "max |u| later"), ("strain_undamaged", "max strain undamaged"),

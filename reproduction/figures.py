@@ -1,5 +1,5 @@
 """What each thesis figure shows, in the thesis's own words (the sentence a check tests is
-quoted), and which checks compare our figure with it (report_checks.py measures them on the
+quoted), and which checks compare our figure with it (reproduction/checks.py measures them on the
 figure's own data, the ``.panel.npz`` that post.plot_fields saves next to every field figure).
 
 Every check tests the quantity the quoted sentence is about: a position (the body returns to its
@@ -21,10 +21,13 @@ class ThesisFigure:
     example: str                # catalogue id
     shows: str                  # what the thesis shows (paraphrase)
     files: tuple = ()           # our PNG names (in the figures folder), thesis order
-    checks: tuple = ()          # names of checks in report_checks.CHECKS
+    checks: tuple = ()          # names of checks in reproduction.checks.CHECKS
     kind: str = "field"         # field | setting | convergence | history | assumed-setting
     quote: str = ""             # the thesis sentence the checks test (verbatim)
     related: tuple = ()         # other figures whose data a check compares with (2.5 with 2.4)
+    event: str = ""             # the run status that ends the thesis's run (collapse, ...)
+    no_statement: str = ""      # why the thesis gives nothing to test (verdict: not comparable)
+    thesis_run: str = ""        # the mesh and time step of the thesis's figure, where stated
 
     @property
     def anchor(self) -> str:
@@ -42,22 +45,25 @@ DAMAGE_CHECKS = {"localised", "min_zeta_lower_right", "min_zeta_top_or_lower_rig
                  "damage_pattern_differs", "physical"}
 
 
-def _f(number, example, shows, files, checks=(), kind="field", quote="", related=()):
+def _f(number, example, shows, files, checks=(), kind="field", quote="", related=(), event="",
+       no_statement="", thesis_run=""):
     return ThesisFigure(number, example, shows, tuple(files), tuple(checks), kind, quote,
-                        tuple(related))
+                        tuple(related), event, no_statement, thesis_run)
 
 
 THESIS_FIGURES = [
     _f("2.1", "2.1-ex1", "square (0,5)^2 with a clamped hole, mesh for n = 10",
-       ["figure_2_1.png"], kind="setting"),
+       ["figure_2_1.png"], kind="setting", thesis_run="n = 10"),
     _f("2.2", "2.1-ex1", "error against h + k: linear convergence (Table 2.1, not set beside ours)",
        ["figure_2_2.png"], kind="convergence"),
     _f("2.3", "2.1-ex2a", "disc |x| < 4 minus a diamond, mesh",
        ["figure_2_3.png"], kind="setting"),
     _f("2.4", "2.1-ex2a", "von Mises stress and damage at t = 1 on the deformed "
-       "body, tension damage only", ["figure_2_4.png"], ("physical",),
+       "body, tension damage only", ["figure_2_4.png"],
        quote="In Figure 2.4 both the von Mises stress norm and the damage field are plotted at "
-       "final time t = 1 s and over the deformed configuration."),
+       "final time t = 1 s and over the deformed configuration.",
+       no_statement="the thesis says only what Figure 2.4 plots; its one statement is the "
+       "comparison with Figure 2.5, judged there"),
     _f("2.5", "2.1-ex2b", "the same for compression damage only; against Figure 2.4 the same stresses, a "
        "different damage distribution",
        ["figure_2_5.png"], ("physical", "stress_pattern_same", "damage_pattern_differs"),
@@ -72,10 +78,11 @@ THESIS_FIGURES = [
        "failure load is no independent check; the curve's shape is not measured)",
        ["figure_2_7.png"]),
     _f("2.8", "2.1-ex3", "failure of the bridge: 'a four hinges mechanism'",
-       ["figure_2_8.png"], ("four_hinges",),
+       ["figure_2_8.png"], ("four_hinges",), event="collapse", thesis_run="h = 0.05, k = 0.001",
        quote="A four hinges mechanism arise in case of a quarter span load."),
     _f("2.9", "2.1-ex3", "damage at failure on the deformed body (x50), four hinges",
-       ["figure_2_9.png"], ("physical", "four_hinges"),
+       ["figure_2_9.png"], ("physical", "four_hinges"), event="collapse",
+       thesis_run="h = 0.05, k = 0.001",
        quote="A four hinges mechanism arise in case of a quarter span load."),
     _f("2.10", "2.2-ex1", "setting and mesh of the first example",
        ["figure_2_10.png"], kind="setting"),
@@ -84,7 +91,7 @@ THESIS_FIGURES = [
     _f("2.12", "2.2-ex3", "deformed mesh (x3) at t = 5: 'the movement of the lower "
        "horizontal boundary, while the upper one remains clamped'; right: u_1 and sigma_tau at "
        "(4, 0), 'absence of movement until the friction bound is reached'",
-       ["figure_2_12_left.png", "figure_2_12_right.png"], ("top_fixed_bottom_moves", "readable"),
+       ["figure_2_12_left.png", "figure_2_12_right.png"], ("top_fixed_bottom_moves",),
        quote="We notice the movement of the lower horizontal boundary, while the upper one remains"
        " clamped"),
     _f("2.13", "2.2-ex3", "stress maximal on the upper boundary; 'the damage is "
@@ -93,7 +100,7 @@ THESIS_FIGURES = [
        quote="As we expected, the damage is concentrated on the most stressed areas, the contact "
        "boundaries."),
     _f("2.14", "2.3-ex1", "unit square, mesh for n = 8", ["figure_2_14.png"],
-       kind="setting"),
+       kind="setting", thesis_run="n = 8"),
     _f("2.15", "2.3-ex1", "error against h + k (Table 2.5), linear convergence",
        ["figure_2_15.png"], kind="convergence"),
     _f("2.16", "2.3-ex2", "block pushed against a foundation", ["figure_2_16.png"],
@@ -119,23 +126,24 @@ THESIS_FIGURES = [
        quote="although the forces have vanished, at final time the configuration is not the "
        "stress-free one"),
     _f("2.22", "2.4-ex1", "unit square, mesh for n = 8", ["figure_2_22_tresca.png"],
-       kind="setting"),
+       kind="setting", thesis_run="n = 8"),
     _f("2.23", "2.4-ex1", "errors against h + k, Tresca (left) and Coulomb (right)",
        ["figure_2_23_left.png", "figure_2_23_right.png"], kind="convergence"),
     _f("2.24", "2.4-ex1", "Tresca, t = 1, n = 64: 'due to the friction, the highest "
        "stressed area, and the corresponding most damaged one, is located at the right lower "
        "corner'", ["figure_2_24.png"], ("physical", "localised", "min_zeta_lower_right"),
+       thesis_run="n = 64, k = 0.002",
        quote="Due to the friction, the highest stressed area, and the corresponding most damaged "
        "one, is located at the right lower corner."),
     _f("2.25", "2.4-ex1", "Coulomb: most stressed/damaged 'at the upper boundary "
        "and at the right lower corner'", ["figure_2_25.png"],
-       ("physical", "localised", "min_zeta_top_or_lower_right"),
+       ("physical", "localised", "min_zeta_top_or_lower_right"), thesis_run="n = 64, k = 0.002",
        quote="We notice now that the highest stressed areas (and so, the most damaged ones) are "
        "located at the upper boundary and at the right lower corner."),
     _f("2.26", "2.4-ex2", "unit square without clamping, large friction bound",
        ["figure_2_26.png"], kind="setting"),
     _f("2.27", "2.4-ex2", "deformed mesh at t = 1: 'the contact boundary remains "
-       "clamped'", ["figure_2_27.png"], ("bottom_fixed", "readable"),
+       "clamped'", ["figure_2_27.png"], ("bottom_fixed",),
        quote="We notice that the contact boundary remains clamped."),
     _f("2.28", "2.4-ex2", "most stressed and most damaged 'at the right lower "
        "contact corner'; right upper corner less damaged", ["figure_2_28.png"],
@@ -149,11 +157,11 @@ THESIS_FIGURES = [
     _f("3.3", "3.1-ex2", "beam clamped at x = 0 on a deformable foundation",
        ["figure_3_3.png"], kind="setting"),
     _f("3.4", "3.1-ex2", "deformed mesh (x4) at t = 1 with the initial outline; no "
-       "penetration into the obstacle", ["figure_3_4.png"], ("readable", "no_penetration"),
+       "penetration into the obstacle", ["figure_3_4.png"], ("no_penetration",), thesis_run="k = 0.01",
        quote="No penetration of the body into the obstacle is produced because of large "
        "deformability coefficient employed"),
     _f("3.5", "3.1-ex2", "highest stresses and most damaged areas 'near to the "
-       "clamped part'", ["figure_3_5.png"], ("physical", "localised", "min_zeta_left"),
+       "clamped part'", ["figure_3_5.png"], ("physical", "localised", "min_zeta_left"), thesis_run="k = 0.01",
        quote="We notice that the highest stresses and the more damaged areas are located near to "
        "the clamped part."),
     _f("3.6", "3.1-ex3", "L-shaped body on a deformable obstacle",
@@ -161,20 +169,22 @@ THESIS_FIGURES = [
     _f("3.7", "3.1-ex3", "deformed meshes (x10), undamaged and damaged: "
        "'inclusion of the damage effect leads to an increase of the magnitude of the deformation "
        "field' (the 'later time' of the check below is the damaged run)",
-       ["figure_3_7_undamaged.png", "figure_3_7_damaged.png"], ("readable", "deformation_grows"),
+       ["figure_3_7_undamaged.png", "figure_3_7_damaged.png"], ("deformation_grows",),
+       thesis_run="k = 0.01",
        quote="Clearly, inclusion of the damage effect leads to an increase of the magnitude of the"
        " deformation field."),
     _f("3.8", "3.1-ex3", "strains at the final time: 'inclusion of the damage "
        "effect leads to an increase of the magnitude of the deformation field'",
        ["figure_3_8_undamaged.png", "figure_3_8_damaged.png"], ("damage_increases_strain",),
+       thesis_run="k = 0.01",
        quote="Clearly, inclusion of the damage effect leads to an increase of the magnitude of the"
        " deformation field."),
     _f("3.9", "3.2-ex1", "unit square, bilateral contact, mesh for n = 8",
-       ["figure_3_9.png"], kind="setting"),
+       ["figure_3_9.png"], kind="setting", thesis_run="n = 8"),
     _f("3.10", "3.2-ex2", "block between two frictional planes",
        ["figure_3_10.png"], kind="setting"),
     _f("3.11", "3.2-ex2", "deformed mesh (x5): 'the lower part of the contact "
-       "boundary remains fixed'", ["figure_3_11.png"], ("bottom_fixed", "readable"),
+       "boundary remains fixed'", ["figure_3_11.png"], ("bottom_fixed",),
        quote="We notice that the lower part of the contact boundary remains fixed because of the "
        "size of the friction bound."),
     _f("3.12", "3.2-ex2", "'correspondence between the more stressed areas and the "
@@ -194,17 +204,17 @@ THESIS_FIGURES = [
        ["figure_3_16.png"], kind="convergence"),
     _f("3.17", "3.3-ex2", "damage on x2 = 3 at several times (self-mending in the "
        "centre, minima at the edges) and zeta(0, 6) reaching ζ* in finite time",
-       ["figure_3_17.png"], ("probe_reaches_star", "minimum_at_edges"),
+       ["figure_3_17.png"], ("probe_reaches_star", "minimum_at_edges"), event="zeta_star_reached",
        quote="It is found that there is self-mending in the center, and after some time the "
        "maximal damage (i.e., the minimum point of the damage field ζ) is located at the "
        "edge points"),
     _f("3.18", "3.3-ex2", "the same for the initial damage b, on x2 = 0",
-       ["figure_3_18.png"], ("probe_reaches_star", "minimum_at_edges"),
+       ["figure_3_18.png"], ("probe_reaches_star", "minimum_at_edges"), event="zeta_star_reached",
        quote="As above, after some time the maximal damage is located at the edge points"),
     _f("3.19", "3.3-ex3", "wrench on a stiff screw, cyclic traction",
        ["figure_3_19.png"], kind="assumed-setting"),
     _f("3.20", "3.3-ex3", "deformed mesh (x2) at T; 'negligible amount of "
-       "interpenetration'", ["figure_3_20.png"], ("readable", "no_penetration"),
+       "interpenetration'", ["figure_3_20.png"], ("no_penetration",),
        quote="As can be seen, the normal compliance contact condition caused a negligible amount "
        "of interpenetration between the wrench and the screw."),
     _f("3.21", "3.3-ex3", "von Mises at T: highest 'at the central region where the "
@@ -222,3 +232,29 @@ def figure_number(filename: str):
     """'figure_2_12_left.png' -> (2, 12, 'left'); None for other PNGs."""
     m = re.match(r"figure_(\d+)_(\d+)(?:_(.*))?\.png$", Path(filename).name)
     return (int(m.group(1)), int(m.group(2)), m.group(3) or "") if m else None
+
+
+#: what a thesis figure draws beside the body (figstyle.draw_guides), by our PNG name: the
+#: foundation under the beam of 3.4/3.5 and the slope plane and obstacle of 3.13 (drawn in
+#: the slope-aligned frame of the run, x1 up the slope)
+GUIDES = {
+    "figure_3_4.png": [{"line": [[0.0, 0.0], [3.0, 0.0]], "label": "the deformable foundation"}],
+    "figure_3_5.png": [{"line": [[0.0, 0.0], [3.0, 0.0]], "label": "the deformable foundation"}],
+    "figure_3_13.png": [{"line": [[0.0, 0.0], [2.0, 0.0]],
+                         "label": "the slope plane (bottom; x1 up the slope, Tresca g = 1)"},
+                        {"line": [[0.0, 0.0], [0.0, 1.0]], "label": "the obstacle (left, g = 1)"}],
+}
+
+#: figures that mark the hinges of the arch's collapse mechanism (from its run's summary.json)
+HINGE_FIGURES = ("figure_2_8.png", "figure_2_9.png")
+
+
+def guides(png: str, summary=None) -> list:
+    """The guides of one of our PNGs: GUIDES, and the mechanism hinges of the arch (its run's
+    summary: position on the centre line, the face that opens)."""
+    out = list(GUIDES.get(png, []))
+    if png in HINGE_FIGURES and summary:
+        out += [{"point": [h["x_m"], h["y_m"]], "mark": h["opening_face"][0].upper(),
+                 "note": "red circles: mechanism hinges (E / I: the extrados / intrados opens)"}
+                for h in summary.get("hinges", []) if h.get("mechanism")]
+    return out

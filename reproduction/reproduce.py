@@ -341,3 +341,36 @@ def run_convergence(mode: str, out: Path, np_: int = 2, only=None, resume=False,
     _finish(index, "studies", start)
     (out / "index.json").write_text(strict_json(index))
     return index
+
+
+def redraw_settings(mode: str, out: Path) -> list:
+    """Redraw the setting figures (kind "mesh") of ``out`` with the current style, without
+    repeating the runs: each job's stepper is built (same mesh, time step and final time, so
+    the loads are drawn at the same time) and only its setting figures are drawn; returns the
+    files redrawn. Serial."""
+    import tempfile
+    from mpi4py import MPI
+    from damage_dolfinx.catalogue import examples
+    from damage_dolfinx.runtime.figures import draw_figure
+    catalogue = examples.catalogue()
+    done = []
+    for job in figure_jobs(mode):
+        ex = catalogue[job.example]
+        meshes = [f for f in ex.figures if f.kind == "mesh"]
+        if not meshes:
+            continue
+        opts = dict(zip(job.options[::2], job.options[1::2]))
+        from damage_dolfinx.cli import _overrides  # the command line's own reading of --set
+        overrides = _overrides([v for k, v in zip(job.options[::2], job.options[1::2])
+                                if k == "--set"])
+        stepper = ex.build(MPI.COMM_WORLD, n=int(opts["--n"]) if "--n" in opts else None,
+                           k=float(opts["--k"]) if "--k" in opts else None,
+                           T=float(opts["--T"]) if "--T" in opts else None,
+                           h=float(opts["--h"]) if "--h" in opts else None,
+                           overrides=overrides)
+        with tempfile.TemporaryDirectory() as tmp:
+            for fig in meshes:
+                draw_figure(ex, fig, stepper, Path(tmp))
+                shutil.copy(Path(tmp) / fig.filename, out / _figure_name(fig.filename, job))
+                done.append(_figure_name(fig.filename, job))
+    return done

@@ -7,13 +7,20 @@ import sys
 import numpy as np
 import pytest
 
+import reproduction.baselines  # noqa: F401 (registers the friction baselines in-process)
+
 # oversubscription: OpenMPI 4 (Debian 12) reads OMPI_MCA_rmaps_base_oversubscribe, OpenMPI 5
 # (Debian 13 and later, PRRTE) PRTE_MCA_rmaps_default_mapping_policy; a 3-rank test needs it on
 # a 2-core runner
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OMPI_MCA_rmaps_base_oversubscribe="1",
            PRTE_MCA_rmaps_default_mapping_policy=":oversubscribe", OMP_NUM_THREADS="1",
-           MPLBACKEND="Agg")
+           MPLBACKEND="Agg",
+           # the reproduction's friction baselines (uzawa, penalty-duality), from the checkout
+           DAMAGE_DOLFINX_PLUGINS="reproduction.baselines",
+           PYTHONPATH=os.pathsep.join(filter(None, [
+               os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+               os.environ.get("PYTHONPATH")])))
 
 
 def run_cli(args, np_=1, check=True, timeout=600):

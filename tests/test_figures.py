@@ -108,8 +108,9 @@ def test_setting_figure_draws_loads_and_supports(tmp_path, monkeypatch):
     seen = {}
     draw = figstyle.draw_setting
     monkeypatch.setattr(figstyle, "draw_setting",
-                        lambda ax, cells, parts, loads=(), note="": seen.update(
-                            parts=parts, loads=loads, note=note) or draw(ax, cells, parts, loads, note))
+                        lambda ax, cells, parts, loads=(), note="", split=None: seen.update(
+                            parts=parts, loads=loads, note=note) or draw(ax, cells, parts, loads,
+                                                                         note, split))
     ex = examples.get("2.3-ex3")
     stepper = ex.build(MPI.COMM_SELF, n=4)
     fig = next(f for f in ex.figures if f.kind == "mesh")
@@ -150,3 +151,32 @@ def test_every_plot_goes_through_figstyle():
               re.search(r"^\s*(import matplotlib|from matplotlib)|\.savefig\(|plt\.subplots",
                         p.read_text(), re.M)]
     assert not direct, direct
+
+
+def test_readable_amplification_one_colour_map_and_distinct_ticks():
+    """A factor that would draw the largest displacement beyond half the body's size is replaced
+    (the note says which); a fully damaged body gets no stretched panel; ticks over a narrow
+    range are distinct numbers; outline edges no part covers are traction-free."""
+    import numpy as np
+    from damage_dolfinx.viz import figscales, figstyle
+    xs = np.linspace(0.0, 4.0, 5)
+    cells = np.array([[(xs[i], xs[j]), (xs[i + 1], xs[j]), (xs[i + 1], xs[j + 1])]
+                      for i in range(4) for j in range(4)])
+    disp = np.zeros_like(cells)
+    disp[..., 0] = 16.0 * (1 - cells[..., 1] / 4)          # 16 m slip of a 4 m square
+    panels = [dict(xy=cells + 3.0 * disp, values=np.ones(len(cells)))]
+    scaled, factor, note = figstyle.readable(panels, cells, 3.0)
+    drawn = np.abs(scaled[0]["xy"] - cells).max()
+    assert factor < 3.0 and "×3 asked for" in note and drawn <= 0.5 * np.hypot(4, 4)
+    small = [dict(xy=cells + 0.01 * disp, values=np.ones(len(cells)))]
+    assert figstyle.readable(small, cells, 0.01)[1:] == (0.01, "")  # readable: kept
+    assert not figscales.narrow_damage(0.010, 0.012, 0.01)        # fully damaged: no panel
+    assert figscales.narrow_damage(0.95, 0.99, 0.01)
+    assert figstyle.STRETCHED_CMAP == figstyle.DAMAGE_CMAP
+    d = figscales.range_decimals(0.9999, 1.0)
+    labels = [f"{v:.{d}f}" for v in np.linspace(0.9999, 1.0, 4)]
+    assert len(set(labels)) == 4
+    bottom = figstyle.boundary_edges(cells)
+    bottom = bottom[np.all(np.isclose(bottom[..., 1], 0.0), axis=1)]
+    free = figstyle._free_edges(cells, [(bottom, "g", "Gamma_C", True)])
+    assert len(free) == len(figstyle.boundary_edges(cells)) - len(bottom)

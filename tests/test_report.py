@@ -42,10 +42,20 @@ def test_quick_figures_and_report(tmp_path):
     assert len(links) >= 50 and set(links) <= anchors           # every row links to its anchor
     toc = re.findall(r'href="#([\w.-]+)"', text[:text.index('id="summary"')])
     assert toc and set(toc) <= anchors
-    counts = re.search(r"\*\*(\d+) reproduced, (\d+) reproduced under a reading, (\d+) setting "
-                       r"assumed, (\d+) not visible in this figure, (\d+) differs, (\d+) not "
-                       r"comparable\*\* \(of (\d+)\)", md)
-    assert counts and sum(map(int, counts.groups()[:6])) == int(counts.group(7))
+    counts = re.search(r"\*\*of (\d+) thesis tables and figures, (\d+) reproduce a result on "
+                       r"the stated data, (\d+) reproduce it only under a reading \(departures "
+                       r"named\), (\d+) are only a drawing of the stated geometry and (\d+) a "
+                       r"drawing of an assumed one; (\d+) not visible in the figure, (\d+) differ, "
+                       r"(\d+) not comparable; (\d+) verdicts are judged on quick", md)
+    assert counts and sum(map(int, counts.groups()[1:8])) == int(counts.group(1))
+    assert int(counts.group(9)) >= 1 and md.index("Preview") < md.index("- [Summary")
+    # one source: every table verdict of fidelity.md is the summary row's verdict
+    from reproduction.verdicts import md_cell
+    fidelity = json.loads((tmp_path / "fidelity" / "fidelity.json").read_text())
+    for t in fidelity["tables"]:
+        assert f"| {md_cell(t['verdict'])} |" in md, t["table"]
+        if t.get("departures"):
+            assert t["verdict"].startswith(("reproduced under a reading", "differs")), t["table"]
     assert 'id="fig-2-14"' in text and "§2.3.3, p. 106" in text   # the figure, where in the thesis
     for anchor in ("performance", "step-floor", "scaling-3d"):  # the benchmark records
         assert f'id="{anchor}"' in text and f'href="#{anchor}"' in text
@@ -131,44 +141,154 @@ def test_markdown_norm_at_line_start_is_text_not_a_table():
     assert html.count("<table>") == 1 and "<p>a reading, ||eps(u)||_L2 = 1e-3, so</p>" in html
 
 
-def test_verdict_classes_on_synthetic_figures(tmp_path):
-    """A damage field that is one colour on the fixed scale is 'not visible in this figure'
-    (and the figure gets a panel on the field's range); a failed check 'differs'; a run under a
-    fitted reading 'reproduced under a reading' with the departure named."""
+def _square(n=8):
     import numpy as np
+    xs = np.linspace(0.0, 1.0, n + 1)
+    return np.array([[(xs[i], xs[j]), (xs[i + 1], xs[j]), (xs[i + 1], xs[j + 1])]
+                     for i in range(n) for j in range(n)])
+
+
+def _panel(tmp_path, name, cells, zeta, stress=None, disp=None, amplification=1.0):
+    """A figure's panel data as a run saves them (deformed cells, stress, damage)."""
     from damage_dolfinx.viz import figstyle
-    from reproduction.checks import departure, judge
+    stress = 1e6 * (2 - cells[..., 1].mean(1)) if stress is None else stress
+    xy = cells if disp is None else cells + amplification * disp
+    panels = [dict(xy=xy, values=stress, name="von_mises", label="von Mises stress [Pa]"),
+              dict(xy=xy, values=zeta, name="zeta", label="damage zeta")]
+    figstyle.save_panels(tmp_path / f"{name}.png", panels, title="t",
+                         amplification=amplification, zeta_star=0.01, ref_xy=cells)
+    return tmp_path / f"{name}{figstyle.PANEL_SUFFIX}"
+
+
+def _run_folder(tmp_path, name, status="completed", t_final=1.0, departures=()):
+    """A run folder as the runner writes it: summary.json (with its reading record) and
+    history.csv."""
+    folder = tmp_path / name
+    folder.mkdir()
+    summary = {"example": "9.9-ex1", "status": status, "t_final": t_final, "T": 1.0,
+               "parameters": {"zeta_star": 0.01}, "assumptions": [],
+               "reading": {"name": "evidence", "default": True, "departures": list(departures)}}
+    (folder / "summary.json").write_text(json.dumps(summary))
+    (folder / "history.csv").write_text("step,t,u_L2\n0,0,1.0\n1,%g,0.2\n" % t_final)
+    return folder
+
+
+def test_planted_departure_reaches_the_figure_verdict(tmp_path):
+    """A run that records a departure in summary.json is never plain 'reproduced': its figure
+    is 'reproduced under a reading', with the departure and its basis named."""
+    from reproduction.checks import judge, run_context
+    from reproduction.classes import category
     from reproduction.figures import ThesisFigure
-    from reproduction.verdicts import CLASSES, category
-    xs = np.linspace(0.0, 1.0, 9)
-    cells = np.array([[(xs[i], xs[j]), (xs[i + 1], xs[j]), (xs[i + 1], xs[j + 1])]
-                      for i in range(8) for j in range(8)])
-    stress = 1e6 * (2 - cells[..., 1].mean(1))              # highest at the bottom (DG0)
+    cells = _square()
+    strong = _panel(tmp_path, "strong", cells, 0.2 + 0.8 * cells[..., 1])
+    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"))
+    fitted = {"what": "kappa = 0.003 instead of kappa = 1", "basis": "fitted", "fitted": True,
+              "against_text": False, "source": "reading", "text": "..."}
+    context = dict(run_context(_run_folder(tmp_path, "run", departures=[fitted])), T_full=1.0)
+    verdict = judge(fig, [strong], context=context)[0]
+    assert category(verdict) == "reproduced under a reading", verdict
+    assert "kappa = 0.003 instead of kappa = 1 (fitted)" in verdict
+    plain = dict(run_context(_run_folder(tmp_path, "plain")), T_full=1.0)
+    assert category(judge(fig, [strong], context=plain)[0]) == "reproduced"
 
-    def npz(zeta, name):
-        panels = [dict(xy=cells, values=stress, name="von_mises", label="von Mises stress [Pa]"),
-                  dict(xy=cells, values=zeta, name="zeta", label="damage zeta")]
-        figstyle.save_panels(tmp_path / f"{name}.png", panels, title="t", amplification=1.0,
-                             zeta_star=0.01, ref_xy=cells)
-        figstyle.render_saved(tmp_path / f"{name}{figstyle.PANEL_SUFFIX}", tmp_path / f"{name}.png")
-        return tmp_path / f"{name}{figstyle.PANEL_SUFFIX}"
 
+def test_planted_early_stop_is_not_comparable(tmp_path):
+    """A run that stops before the thesis's final time is never evidence: 'not comparable',
+    whether it was cut (a quick run's --T) or stopped on its own; a stop at the event the
+    thesis's statement is about (the arch's collapse) is not early."""
+    from reproduction.checks import judge, run_context
+    from reproduction.classes import category
+    from reproduction.figures import ThesisFigure
+    cells = _square()
+    strong = _panel(tmp_path, "strong", cells, 0.2 + 0.8 * cells[..., 1])
+    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"))
+    stopped = dict(run_context(_run_folder(tmp_path, "stop", "zeta_star_reached", 0.4)),
+                   T_full=1.0)
+    verdict = judge(fig, [strong], context=stopped)[0]
+    assert category(verdict) == "not comparable" and "t = 0.4 of the thesis's T = 1" in verdict
+    cut = dict(run_context(_run_folder(tmp_path, "cut")), T_full=1.0, T_run=0.5)
+    assert category(judge(fig, [strong], context=cut)[0]) == "not comparable"
+    event = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
+                         event="collapse")
+    collapse = dict(run_context(_run_folder(tmp_path, "collapse", "collapse", 0.02)), T_full=0.3)
+    assert category(judge(event, [strong], context=collapse)[0]) == "reproduced"
+
+
+def test_planted_differs_whose_feature_holds(tmp_path):
+    """Figure 2.12's statement (top edge clamped, bottom edge moves) holding in the data is not
+    'differs', however large the drawn displacement; a failed check quotes our number."""
+    import numpy as np
+    from reproduction.checks import judge
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES
+    fig = next(f for f in THESIS_FIGURES if f.number == "2.12")
+    cells = 4 * _square()
+    disp = np.zeros_like(cells)
+    disp[..., 0] = 16.0 * (1 - cells[..., 1] / 4)             # bottom slides 16 m, top fixed
+    npz = _panel(tmp_path, "slide", cells, np.ones(cells.shape[:2]), disp=disp, amplification=3.0)
+    context = {"T_full": 5.0, "status": "completed", "t_final": 5.0, "departures": []}
+    verdict = judge(fig, [npz], context=context)[0]
+    assert category(verdict) == "reproduced", verdict
+    assert "top edge 0.00, bottom edge 1.00 of max |u|" in verdict
+    disp[..., 0] = 16.0 * cells[..., 1] / 4                   # the top moves: the statement fails
+    npz = _panel(tmp_path, "top", cells, np.ones(cells.shape[:2]), disp=disp, amplification=3.0)
+    verdict = judge(fig, [npz], context=context)[0]
+    assert category(verdict) == "differs" and "top edge 1.00, bottom edge 0.00" in verdict
+
+
+def test_visibility_and_statement_rules(tmp_path):
+    """'not visible' only when every check holds and the damage spans under 5 % of [zeta*, 1];
+    a field over a fifth of the scale is visible; no damage at all fails a damage statement;
+    a figure without a statement of its own is not comparable."""
+    import numpy as np
+    from reproduction.checks import judge
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES, ThesisFigure
+    cells = _square()
     fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"))
-    faint = npz(0.95 + 0.04 * cells[..., 1], "faint")       # most damaged at the bottom, narrow
-    verdict, got, _ = judge(fig, [faint])
+    faint = _panel(tmp_path, "faint", cells, 0.95 + 0.04 * cells[..., 1])
+    verdict = judge(fig, [faint])[0]
     assert category(verdict) == "not visible in this figure" and "rank together" in verdict
-    strong = npz(0.2 + 0.8 * cells[..., 1], "strong")
-    assert judge(fig, [strong])[0] == "reproduced"
-    wrong = npz(1.0 - 0.8 * cells[..., 1], "wrong")           # most damaged at the top
-    assert judge(fig, [wrong])[0].startswith(
-        "differs: what the thesis says does not hold in our data: stress and damage")
-    fitted = "R1 (evidence reading; FITTED value): kappa = 0.003 instead of kappa = 1 (line 3973). x"
-    verdict = judge(fig, [strong], context={"departures": [fitted]})[0]
-    assert verdict == "reproduced under a reading: kappa = 0.003 instead of kappa = 1 (fitted)"
-    assert category(verdict) in CLASSES
-    assert departure(fitted) == "kappa = 0.003 instead of kappa = 1 (fitted)"
-    none = npz(np.full(cells.shape[:2], 0.99995), "none")      # no damage: nothing to locate
-    assert judge(fig, [none])[0].startswith("not visible in this figure: no damage")
+    fifth = _panel(tmp_path, "fifth", cells, 0.75 + 0.2 * cells[..., 1])
+    assert category(judge(fig, [fifth])[0]) == "reproduced"
+    wrong = _panel(tmp_path, "wrong", cells, 1.0 - 0.8 * cells[..., 1])
+    assert category(judge(fig, [wrong])[0]) == "differs"
+    none = _panel(tmp_path, "none", cells, np.full(cells.shape[:2], 0.99995))
+    assert category(judge(fig, [none])[0]) == "differs"
+    fig_2_4 = next(f for f in THESIS_FIGURES if f.number == "2.4")
+    assert category(judge(fig_2_4, [faint])[0]) == "not comparable"
+
+
+def test_quick_verdicts_and_table_departures():
+    """A quick verdict ends in '(quick)'; a table on data with a departure (Table 2.4's norm)
+    is 'reproduced under a reading' and says what the match depends on."""
+    import sys
+    from reproduction import CHECKOUT
+    from reproduction.classes import QUICK, Evidence, category, classify
+    sys.path.insert(0, str(CHECKOUT / "benchmarks" / "reproduction"))
+    import fidelity
+    checks = [("errors of the thesis's size", True, "median 0.7"), ("rate", True, "0.78 against 0.81")]
+    assert classify(Evidence(kind="table", checks=checks, quick=True)).endswith(QUICK)
+    entry = {"thesis_norm": "H1 (V) norm", "our_error": "max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)",
+             "component_medians": {"error_u_V": 0.27}}
+    deps = fidelity.norm_departures(entry)
+    verdict = classify(Evidence(kind="table", checks=checks, departures=deps))
+    assert category(verdict) == "reproduced under a reading" and "0.27x" in verdict
+
+
+def test_runs_record_their_departures():
+    """summary.json's reading record (written by every run) carries the departures from the
+    stated text with their basis, including the stated values our data contradict."""
+    from damage_dolfinx.catalogue import departures, examples
+    rec = departures.record(examples.get("2.3-ex1"))
+    assert rec["name"] == "literal" and rec["departures"][0]["against_text"]
+    assert "c_nu = 1e10" in rec["departures"][0]["what"]
+    rec = departures.record(examples.get("3.2-ex1"))
+    assert rec["name"] == "evidence" and any(d["fitted"] for d in rec["departures"])
+    assert departures.record(examples.get("2.1-ex1"))["departures"] == []
+    for ex in examples.catalogue().values():   # the label of each reading counts them all
+        n = len(departures.record(ex)["departures"])
+        assert (f"{n} departure(s)" in ex.assumptions[0]) == (n > 0), ex.id
 
 
 def test_reader_text_and_units():

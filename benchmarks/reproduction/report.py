@@ -27,7 +27,7 @@ p.add_argument("--results", default="results")
 p.add_argument("--pdf", action="store_true", help="also print REPORT.pdf with headless Chromium")
 a = p.parse_args()
 page = report.build(a.results)
-counts = re.search(r"\*\*(\d+ reproduced, .*?)\*\*", page.with_suffix(".md").read_text())
+counts = re.search(r"\*\*(of \d+ thesis .*?)\*\*", page.with_suffix(".md").read_text())
 print(f"report: {page.parent}/ (REPORT.html, REPORT.md, images/)"
       + (f": {counts.group(1)}" if counts else ""))
 chromium = shutil.which("chromium") or shutil.which("chromium-browser")

@@ -21,7 +21,10 @@ import numpy as np
 import ufl
 from mpi4py import MPI
 
-from damage_dolfinx import compat
+import sys
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the checkout: reproduction/
+import reproduction.baselines  # noqa: E402,F401 (registers uzawa and penalty-duality)
+from damage_dolfinx import compat  # noqa: E402
 from damage_dolfinx.catalogue import examples
 from damage_dolfinx.runtime import runner
 from damage_dolfinx.numerics.constitutive import eps

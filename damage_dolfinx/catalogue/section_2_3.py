@@ -19,9 +19,10 @@ def examples():
                    "memory_mode": "auto"})
 
     common = [
-        "departure (against the text): contact stiffness c_nu = 1e10, the mu = 1e10 of "
-        "p_nu(r) = r_+/mu (2.145, line 2161) used as the stiffness; the text's p_nu has the "
-        "stiffness 1/mu = 1e-10 (a foundation without resistance), we read a near-rigid one",
+        "departure (against the text): contact stiffness c_nu = 1e10 instead of the text's "
+        "1/mu = 1e-10: (2.145), line 2161, states p_nu(r) = r_+/mu with mu = 1e10; we use mu "
+        "as the stiffness (a near-rigid foundation), the text's p_nu is a foundation without "
+        "resistance",
         "G12: gap = 0", "G15: variant A, q_star = 1000",
         "G16: instantaneous elasticity B undamaged and untruncated",
         "memory by the left rectangle rule (2.136), g = zeta Phi_L(B eps(u)) stored in DG1 tensors",

@@ -93,7 +93,7 @@ def examples():
             "lam_u = 2000, L_trunc = 1000, T = 1; no stop at zeta_star (G43)",
             "G10: structured n x n grid, diagonals right (nested meshes)",
             "error max_n ||u_n - u_n^hk||_L2 + ||zeta_n - zeta_n^hk||_L2 (Cor. 3.3, the thesis' "
-            "'L2 errors'); G36: the thesis table is x100 and its label garbled, compare trends",
+            "'L2 errors'); the thesis's table is not set beside ours",
             "1.8: with m_visc = 1 the explicit terms are harmless: k_max = 1.14 (n = 8), 0.73 "
             "(n = 128) from stability.py, far above the largest k = 0.1 of the table; the check "
             "is therefore off by default (it costs ~27 s per build at n = 128, and a convergence "

@@ -90,6 +90,9 @@ class Model:
     title: str = ""
     #: the contact roles its Gamma_C may play (boundary role names)
     contact_roles: tuple = ()
+    #: boundary roles of its own beyond clamped, traction and contact: {role: facet tag the
+    #: model reads} (tags other than 1, 2, 3)
+    extra_roles: dict = {}
     #: inertia: k must be given (the limit depends on the mesh)
     dynamic: bool = False
     #: what limits k ("" when nothing does)
@@ -100,6 +103,9 @@ class Model:
     history_columns: tuple = ()
     #: the sub-steps in order: (attribute holding the solver, kind, PETSc options prefix)
     scheme: tuple = ()
+    #: quadrature degree of the contact integrals (None: estimated from the integrand); the
+    #: contact resultant uses the scheme's, so that it balances the load exactly
+    contact_quadrature_degree: Optional[int] = None
 
     # -- the declarations a run reads before building anything
     @classmethod
@@ -117,6 +123,14 @@ class Model:
         """The closed-form stability limit of a quasistatic scheme with an explicit term
         (inf: none, or mesh-dependent, checked when the model is built)."""
         return math.inf
+
+    @classmethod
+    def boundary_roles(cls) -> dict:
+        """role -> the facet tag the model reads there: ``clamped`` 1 (Gamma_D), ``traction`` 2
+        (Gamma_N), each of ``contact_roles`` 3 (Gamma_C), and ``extra_roles``."""
+        from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+        return {"clamped": GAMMA_D, "traction": GAMMA_N,
+                **{role: GAMMA_C for role in cls.contact_roles}, **cls.extra_roles}
 
     @classmethod
     def with_roles(cls, params: ModelParameters, roles: set) -> ModelParameters:
@@ -287,10 +301,7 @@ class Model:
                  compat.form(ufl.inner(eps(du), eps(w)) * ufl.dx)]
         mats = []
         for a in forms:
-            A = compat.create_matrix(a)
-            compat.assemble_matrix(A, a, [])
-            A.assemble()
-            mats.append(bookkeeping.block_operator(A))
+            mats.append(bookkeeping.norm_matrix(a, V.dofmap.index_map_bs))
         m_form = compat.form(ufl.TestFunction(Z) * ufl.dx)
         m = compat.create_vector(m_form)
         with m.localForm() as ml:
@@ -315,8 +326,10 @@ class Model:
             else:
                 from damage_dolfinx.geometries import GAMMA_C
                 n = ufl.FacetNormal(self.mesh)
+                degree = self.contact_quadrature_degree
                 ds = ufl.Measure("ds", domain=self.mesh,
-                                 subdomain_data=self.data.geometry.facet_tags)
+                                 subdomain_data=self.data.geometry.facet_tags,
+                                 metadata={} if degree is None else {"quadrature_degree": degree})
                 self._resultant_forms = [compat.form(p * n[i] * ds(GAMMA_C))
                                          for i in range(self.mesh.geometry.dim)]
         if self._resultant_forms is None:

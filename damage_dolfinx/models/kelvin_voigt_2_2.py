@@ -127,7 +127,7 @@ class KelvinVoigtTresca(Model):
 
     def scalars(self) -> dict:
         out = super().scalars()
-        if not self.extra_history_columns:
+        if not hasattr(self, "_probe"):
             return out
         nodes, i, residual, r = self._probe  # R(w) = a(v, w) - l(w) = -sum_i m_i Phi_i w_tau,i
         with r.localForm() as rl:

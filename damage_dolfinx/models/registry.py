@@ -55,7 +55,8 @@ def register(cls):
 
 
 def model(which):
-    """The model class of ``which``: an id, or a model class itself."""
+    """The model class of ``which``: an id (a key of ``damage_dolfinx.MODELS``), or a model
+    class itself."""
     from damage_dolfinx.models.base import Model
     if isinstance(which, type) and issubclass(which, Model):
         if not which.id:

@@ -82,8 +82,8 @@ def check_time_step(k: float, k_max: float, where: str, action: str = "warn") ->
                f"scheme's explicit terms ({where}, k/k_max = {ratio:.3g}); use "
                f"k <= {SAFETY * k_max:.4g} (0.8 k_max)")
     if action == "error":
-        raise InputError(message + ", or --allow-unstable (Problem(allow_unstable=True)) to run "
-                         "it anyway")
+        raise InputError(message + " (problem.k_max() gives k_max before the run), or "
+                         "allow_unstable=True to run it anyway")
     if MPI.COMM_WORLD.rank == 0:
         print(f"WARNING: {message}", file=sys.stderr, flush=True)
     return ratio

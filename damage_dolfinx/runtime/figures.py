@@ -20,6 +20,20 @@ def auto_amplification(stepper, diameter) -> float:
     return 0.1 * diameter / umax if umax > 0 else 1.0
 
 
+def _setting_split(ex, stepper):
+    """Contact parts whose friction bound changes along them (3.2 Example 2: g = 1 on the top
+    plane, 1000 on the bottom one): {label: (name, function of points)} for the setting figure."""
+    builder = (getattr(ex, "builders", None) or {}).get("friction_bound")
+    if builder is None:
+        return None
+    import ufl
+    expr = builder(ufl.SpatialCoordinate(stepper.mesh))
+
+    def values(points):
+        return [float(expr(tuple(p))) for p in points]
+    return {"Gamma_C (contact)": ("friction bound g", values)}
+
+
 def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
     """One catalogue figure (PNG) of the current state; returns its file entry."""
     out = Path(out)
@@ -50,7 +64,7 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
         post.plot_mesh(stepper.data.geometry, out / filename, title=fig.title,
                        labels={GAMMA_D: "Gamma_D (clamped)", GAMMA_N: "Gamma_N (loaded/free)",
                                GAMMA_C: "Gamma_C (contact)"},
-                       loads=post.setting_loads(stepper))
+                       loads=post.setting_loads(stepper), split=_setting_split(ex, stepper))
         return {"file": filename}
     fields = {"von_mises": (stepper.von_mises, "von Mises stress [Pa]"),
               "zeta": (stepper.zeta, "damage zeta [-]")}
@@ -59,5 +73,5 @@ def draw_figure(ex, fig, stepper, out: Path, suffix="") -> dict:
     amp = fig.amplification or auto_amplification(stepper, diameter)
     post.plot_fields(stepper.u, [fields[f] for f in fig.fields], out / filename,
                      amplification=amp, title=f"{fig.title} (t = {stepper.t:.4g})", outline=True,
-                     mesh_lines=fig.mesh_lines)
+                     mesh_lines=fig.mesh_lines)  # figstyle.readable keeps the drawing readable
     return {"file": filename, "t": stepper.t, "amplification": amp}

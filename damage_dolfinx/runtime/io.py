@@ -26,6 +26,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx import compat
+from damage_dolfinx.runtime import series
 from damage_dolfinx.runtime.atomic import (STUCK_SECONDS, OutputError, atomic_write_bytes, collective,  # noqa: F401
                      describe, npz_writer, strict_json, write_json)
 from damage_dolfinx.parameters import InputError
@@ -130,12 +131,25 @@ class XDMFSeries:
     the write succeeds anyway), and the file object whose close failed is never destroyed
     (DOLFINx 0.5 crashes closing it a second time)."""
 
-    def __init__(self, path, msh):
+    def __init__(self, path, msh, index=None, since=None):
+        """A new series at ``path``; with ``index`` (a restart's segment) the run's index file,
+        whose time steps t < ``since`` are kept before this segment's (series.py)."""
         self.path, self.comm = Path(path), msh.comm
+        self.index, self._earlier = (Path(index) if index else None), None
+        if self.index is not None and self.index != self.path and self.comm.rank == 0:
+            self._earlier = series.earlier_steps(self.index, since)
         f = compat.xdmf_file(self.comm, self.path, "w")
         with _failed_files_kept(f), _stderr_held_back():
             with f:
                 f.write_mesh(msh)
+
+    @property
+    def segments(self) -> list:
+        """The .h5 files the run's series references (rank 0; [] elsewhere)."""
+        if self.comm.rank != 0:
+            return []
+        names = [] if self._earlier is None else series.data_files(self._earlier)
+        return names + [n for n in [self.path.stem + ".h5"] if n not in names]
 
     def write(self, functions, t: float):
         """Append the fields at ``t``. DOLFINx rewrites the whole XML file in place, so a copy
@@ -164,6 +178,15 @@ class XDMFSeries:
                     f.write_function(fn, t)
         if self.comm.rank == 0:
             backup.unlink()
+            if self._earlier is not None:  # the run's index: earlier segments + this one
+                xml = series.index_xml(self._earlier, self.path)
+                atomic_write_bytes(self.index, lambda f: f.write(xml))
+
+
+def series_outputs(xdmf) -> dict:
+    """The summary.json outputs entries of the run's time series (collective)."""
+    segments = xdmf.comm.bcast(xdmf.segments, root=0)
+    return {"xdmf": "fields.xdmf", "xdmf_data": segments, "xdmf_series": series.MECHANISM}
 
 
 def repair_xdmf(out) -> list:

@@ -14,6 +14,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx import departures
+from damage_dolfinx.numerics.contact_output import ContactOutput
 from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.runtime.cases import resolve
 from damage_dolfinx.numerics.damage import fast_path_counts
@@ -48,14 +49,14 @@ class Run(RunRecords):
         if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
                 or every < 1:
             raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
-        for name, value in (("--write-every", write_every),
-                            ("--checkpoint-every", checkpoint_every)):
+        for name, value in (("write_every", write_every),
+                            ("checkpoint_every", checkpoint_every)):
             if value is not None and (isinstance(value, bool) or not isinstance(value, int)
                                       or value < 1):
                 raise InputError(f"{name} must be a whole number >= 1, got {value!r}")
         if not (isinstance(checkpoint_seconds, (int, float)) and checkpoint_seconds >= 0
                 and math.isfinite(checkpoint_seconds)):
-            raise InputError(f"--checkpoint-seconds must be a finite number >= 0 (0: none), "
+            raise InputError(f"checkpoint_seconds must be a finite number >= 0 (0: none), "
                              f"got {checkpoint_seconds!r}")
         if mesh_file is not None:
             check_mesh_file(mesh_file, ex.dim, lambda: ex.mesh_requirements()[1], comm=comm)
@@ -105,13 +106,14 @@ class Run(RunRecords):
                     print(f"damage-dolfinx: nothing to do: the run in {str(self.out)!r} ended "
                           f"({previous['status']}) at t = {previous['t_final']:.6g} after "
                           f"{previous['steps_done']} steps; its outputs are unchanged"
-                          + (" (a larger --T continues it)" if previous["status"] == "completed"
+                          + (" (a larger T continues it)" if previous["status"] == "completed"
                              else ""), flush=True)
                 self.summary = previous
                 return False
         self.xdmf_name = f"fields_from_step{resume[1]['step']}.xdmf" if resume else "fields.xdmf"
         planned = {"summary.json", "history.csv", self.xdmf_name, self.xdmf_name[:-5] + ".h5",
-                   self.xdmf_name + ".bak", "fields_final.npz", "checkpoint.json",
+                   self.xdmf_name + ".bak", "fields.xdmf", "fields.xdmf.tmp", "fields_final.npz",
+                   "checkpoint.json",
                    *checkpoint.GENERATIONS, *(fig.filename for fig in ex.figures
                                                if o["figures"])}
         description = previous["description"] if previous else None
@@ -142,6 +144,7 @@ class Run(RunRecords):
                                       mesh_file, self.configured), "cannot set up the solvers")
         except ConvergenceError as exc:
             raise InputError(str(exc)) from None
+        ContactOutput.for_model(self.stepper)  # contact quantities in history.csv and XDMF
 
     def _check_checkpoints(self):
         stepper, o = self.stepper, self.options
@@ -191,13 +194,15 @@ class Run(RunRecords):
         files = {}
 
         def open_files():
-            files["xdmf"] = io.XDMFSeries(out / self.xdmf_name, stepper.mesh)
+            files["xdmf"] = io.XDMFSeries(out / self.xdmf_name, stepper.mesh, out / "fields.xdmf",
+                                          self.resume["t"] if self.resume else None)
             files["history"] = io.CSVHistory(out / "history.csv", columns, comm,
                                              keep_until_step=self.resume["step"]
                                              if self.resume else None)
         io.collective(comm, out, f"{self.xdmf_name} / history.csv (opening)", open_files)
         self.columns = set(columns)
         self.xdmf, self.history = files["xdmf"], files["history"]
+        self.summary["outputs"].update(io.series_outputs(self.xdmf))
         self.report = Progress(self.ex.id, self.N, comm, enabled=self.options["progress"])
         # models without track() compute their scalars (whatever they keep track of stays right)
         self.track = getattr(stepper, "track", None) or stepper.scalars

@@ -146,7 +146,7 @@ class RunRecords:
             self.save_checkpoint()
         self.summary.update(status="interrupted", signal=name, wall_time_s=self.wall_time())
         self.write_summary()
-        kept = ("checkpoint written; --restart continues the run" if self.supported
+        kept = ("checkpoint written; restart=True continues the run" if self.supported
                 else f"example {self.ex.id} has no checkpoints: the history and fields so far "
                 "stay")
         raise RunInterrupted(signum, f"stopped by {name} after step {self.stepper.n} "

@@ -180,7 +180,7 @@ def read_manifest(out):
             raise ValueError("not a damage-dolfinx manifest")
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError(f"{str(path)!r} is unreadable ({exc}); nothing in {str(out)!r} was "
-                         "touched: move the folder aside or choose another --out") from None
+                         "touched: move the folder aside or choose another out folder") from None
     return data["kind"], set(files) | {MANIFEST}
 
 
@@ -264,20 +264,20 @@ def _claim(out, kind, planned, restart, overwrite, description, apply=True):
                          "its own: choose another --out (nothing was touched)")
     if found == other_kind:
         raise InputError(f"{str(out)!r} holds {what[other_kind]}; {what[kind]} needs a folder "
-                         "of its own: choose another --out (nothing was touched)")
+                         "of its own: choose another out folder (nothing was touched)")
     earlier = found == kind and bool(ours - {MANIFEST, *HIDDEN})
     if others and found is None:
         raise InputError(f"{str(out)!r} holds files damage-dolfinx did not write "
-                         f"({_listing(others)}) and no {MANIFEST}: choose another --out or an "
+                         f"({_listing(others)}) and no {MANIFEST}: choose another out folder or an "
                          "empty folder (nothing was touched)")
     clash = others & {n for p in planned for n in (p, p + ".tmp")}
     if clash:
         raise InputError(f"{str(out)!r} holds {_listing(clash)}, not written by damage-dolfinx "
                          f"(not in its {MANIFEST}), where this {kind} would write: move "
-                         "them or choose another --out (nothing was touched)")
+                         "them or choose another out folder (nothing was touched)")
     if earlier and not restart and not overwrite:
-        raise InputError(f"{str(out)!r} holds {description or what[kind]}; --restart "
-                         "continues it, --overwrite replaces it, or choose another --out")
+        raise InputError(f"{str(out)!r} holds {description or what[kind]}; restart=True "
+                         "continues it, overwrite=True replaces it, or choose another out folder")
     if not apply:
         return earlier
     keep = set()

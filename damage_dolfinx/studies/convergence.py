@@ -421,6 +421,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
                              definition)
     io.collective(comm, out, "the tables and convergence.png", tables)  # OutputError: exit 4
     if comm.rank == 0:
-        print((out / "errors.md").read_text(), flush=True)
+        if progress:  # progress=False prints nothing
+            print((out / "errors.md").read_text(), flush=True)
     io.collective(comm, out, "summary.json", io.write_json, out / "summary.json", summary, comm)
     return summary

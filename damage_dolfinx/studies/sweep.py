@@ -161,7 +161,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     if existing is not None and {key: existing.get(key) for key in mapping} != \
             json.loads(json.dumps(mapping)):
         raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
-                         "T in its points.json); choose another --out")
+                         "T in its points.json); choose another out folder")
     out = io.prepare_output_dir(out, comm)
     states = claim_sweep_folder(out, len(points), restart, comm)
     track(out, "sweep")

@@ -61,10 +61,20 @@ def damage_ticks(vmin, vmax, zeta_star):
 
 #: a damage field whose range covers less than this fraction of [zeta*, 1] is one colour on the
 #: fixed scale: the figure adds a panel on the field's own range (red frame on the fixed bar)
-NARROW_DAMAGE = 0.25
+NARROW_DAMAGE = 0.05
+#: a body whose damage stays within this of zeta* (in units of 1 - zeta*) is fully damaged
+FULLY_DAMAGED = 0.09
 
 
 def narrow_damage(lo: float, hi: float, zeta_star: float) -> bool:
     """True when the damage range [lo, hi] is too narrow to be seen on the fixed [zeta*, 1]
-    scale but not constant (a constant field has nothing to stretch)."""
-    return hi - lo < NARROW_DAMAGE * (1 - zeta_star) and hi - lo > 1e-6
+    scale but not constant (a constant field has nothing to stretch) and the body is not
+    fully damaged (a pattern inside a fully damaged body would mislead)."""
+    return (hi - lo < NARROW_DAMAGE * (1 - zeta_star) and hi - lo > 1e-6
+            and hi > zeta_star + FULLY_DAMAGED * (1 - zeta_star))
+
+
+def range_decimals(lo: float, hi: float, nticks: int = 4) -> int:
+    """Decimals that write ticks over [lo, hi] as distinct numbers (never '1, 1, 0.9999')."""
+    step = (hi - lo) / max(1, nticks)
+    return int(min(8, max(0, math.ceil(-math.log10(step)) if step > 0 else 2)))

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks,  # noqa: F401
+from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks, range_decimals,  # noqa: F401
                         is_damage, narrow_damage, shared_limits, si_unit)
 from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
                       error_mathtext, is_round, mathtext, round_amplification)
@@ -171,8 +171,65 @@ def _frame(ax, xy_list):
     ax.set_ylabel(r"$x_2$ [m]")
 
 
+#: the drawn (amplified) largest displacement stays below this fraction of the body's diameter,
+#: so that the drawn body stays within about 1.5 times its size
+READABLE = 0.5
+
+
+def readable(panels, ref_xy, amplification):
+    """(panels, factor, note): the panels redrawn with a factor that keeps the drawn largest
+    displacement below READABLE of the body's diameter (the automatic 10 %, rounded) when the
+    factor asked for (a thesis's) would not; ``note`` says which factor was replaced."""
+    if ref_xy is None or not amplification:
+        return panels, amplification, ""
+    ref = np.asarray(ref_xy, float)
+    size = float(np.hypot(*np.ptp(ref.reshape(-1, 2), axis=0)))
+    drawn = max(float(np.max(np.linalg.norm(np.asarray(p["xy"], float) - ref, axis=-1)))
+                for p in panels)
+    if size == 0 or drawn <= READABLE * size:
+        return panels, amplification, ""
+    umax = drawn / amplification
+    factor = round_amplification(0.1 * size / umax)
+    scaled = [dict(p, xy=ref + (np.asarray(p["xy"], float) - ref) * (factor / amplification))
+              for p in panels]
+    return scaled, factor, (f"\n(the ×{amplification:g} asked for would draw |u| at "
+                            f"{drawn / size:.2g}× the body's size)")
+
+
+def draw_guides(ax, guides, xy=None, ref_xy=None):
+    """What the thesis's figure draws beside the body: obstacle and friction planes (``line``:
+    two end points, drawn as a thick grey line with its label) and marked points (``point``:
+    an undeformed position, drawn where that material point is in the drawn configuration:
+    the hinges of the arch)."""
+    for g in guides or ():
+        if "line" in g:
+            (x0, y0), (x1, y1) = g["line"]
+            ax.plot([x0, x1], [y0, y1], color="0.35", lw=3.0, solid_capstyle="butt", zorder=4)
+        elif "point" in g:
+            p = np.asarray(g["point"], float)
+            if xy is not None and ref_xy is not None:
+                ref = np.asarray(ref_xy, float).reshape(-1, 2)
+                p = np.asarray(xy, float).reshape(-1, 2)[np.argmin(np.linalg.norm(ref - p, axis=1))]
+            ax.plot(*p, marker="o", ms=7, mfc="none", mec="red", mew=1.6, zorder=5)
+            centre = np.mean(ax.get_xlim()), np.mean(ax.get_ylim())
+            if xy is not None:
+                pts = np.asarray(xy, float).reshape(-1, 2)
+                centre = (pts.min(0) + pts.max(0)) / 2
+            inward = np.asarray(centre) - p
+            inward = 11 * inward / max(np.linalg.norm(inward), 1e-300)
+            ax.annotate(g.get("mark", ""), xy=p, fontsize=7, color="red", xytext=inward,
+                        textcoords="offset points", ha="center", va="center", zorder=5)
+    lines = [g["label"] for g in guides or () if "line" in g and g.get("label")]
+    notes = [g["note"] for g in guides or () if g.get("note")] + \
+        ([f"grey line{'s' if len(lines) > 1 else ''}: " + "; ".join(lines)] if lines else [])
+    if notes:  # under the x label, never over the body
+        ax.annotate("; ".join(dict.fromkeys(notes)), xy=(0.5, 0.0), xycoords="axes fraction",
+                    xytext=(0, -36), textcoords="offset points", ha="center", va="top",
+                    fontsize=7, color="0.2")
+
+
 def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_star=None,
-                  mesh_only=False, limits=None):
+                  mesh_only=False, limits=None, guides=None):
     """Draw the panels of one figure. ``panels``: list of dicts with ``xy`` (nc, 3, 2) deformed
     triangles, ``values`` (nc, 3) P1 or (nc,) DG0, ``name`` and ``label``. ``limits``: optional
     {panel index: (vmin, vmax)} (shared pair scales). A panel's optional ``title`` replaces the
@@ -180,6 +237,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     every panel has a title (distinct bodies, e.g. undamaged and damaged runs side by side).
     Returns the colour limits used per panel (None for a mesh-only panel)."""
     pyplot = plt()
+    panels, amplification, replaced = readable(panels, ref_xy, amplification)
     nplot = len(panels) if not mesh_only or all("title" in p for p in panels) else 1
     allxy = [p["xy"] for p in panels] + ([ref_xy] if ref_xy is not None else [])
     extra = 0 if mesh_only or zeta_star is None else sum(
@@ -227,7 +285,9 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
             used.append((vmin, vmax))
         if ref_xy is not None:
             draw_outline(ax, np.asarray(ref_xy))
-        _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else []))
+        draw_guides(ax, guides, xy, ref_xy)
+        _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else [])
+               + [np.asarray(g["line"], float) for g in guides or () if "line" in g])
     for ax, (src, tri, vals, lo, hi) in zip(axes[nplot:], stretched):
         _stretched_damage(fig, ax, tri, vals, lo, hi)
         if ref_xy is not None:
@@ -236,7 +296,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
         ax.set_ylim(src.get_ylim())
         ax.set_aspect("equal")
         ax.set_xlabel(src.get_xlabel())
-    full = mathtext(title) + f" — {amplification_text(amplification)}"
+    full = mathtext(title) + f" — {amplification_text(amplification)}{replaced}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
     fig.savefig(path, dpi=DPI, bbox_inches="tight")
@@ -248,12 +308,16 @@ def _stretched_damage(fig, ax, tri, vals, lo, hi):
     """The same damage field on a colour scale stretched to its own range [lo, hi]."""
     im = draw_field(ax, tri, vals, STRETCHED_CMAP, lo, hi)
     cb = colorbar(fig, ax, im, "$\\zeta$ (scale: range of the field)")
-    plain_ticks(cb.ax.yaxis)
+    from matplotlib.ticker import FuncFormatter, MaxNLocator
+    digits = range_decimals(lo, hi)
+    cb.ax.yaxis.set_major_locator(MaxNLocator(4))
+    cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.{digits}f}"))
     ax.set_title(f"the same damage, colours stretched\nto its range [{lo:.3g}, {hi:.3g}]")
 
 
-#: colour map of the stretched damage panel (distinct from the fixed one: not to be compared)
-STRETCHED_CMAP = "cividis"
+#: colour map of the stretched damage panel: the damage's own (one colour map per field); its
+#: colour bar and title say that the scale is the field's range
+STRETCHED_CMAP = DAMAGE_CMAP
 
 
 def suptitle_on_top(fig, text):
@@ -289,22 +353,28 @@ def load_panels(npz):
     return panels, meta, (d["ref_xy"] if "ref_xy" in d else None)
 
 
-def render_saved(npz, png, limits=None) -> list:
+def render_saved(npz, png, limits=None, guides=None) -> list:
     panels, meta, ref = load_panels(npz)
     return render_fields(panels, png, title=meta.get("title", ""),
                          amplification=meta.get("amplification", 1.0), ref_xy=ref,
                          zeta_star=meta.get("zeta_star"), mesh_only=meta.get("mesh_only", False),
-                         limits=limits)
+                         limits=limits, guides=guides)
 
 
 def render_pair(npz_a, npz_b, png_a, png_b):
     """Re-render two figures of a thesis pair with one stress scale per non-damage panel."""
-    (pa, ma, _), (pb, mb, _) = load_panels(npz_a), load_panels(npz_b)
+    return render_shared([npz_a, npz_b], [png_a, png_b])
+
+
+def render_shared(npzs, pngs):
+    """Re-render figures of one run or one thesis pair with one scale per non-damage panel
+    (a stress that has nearly vanished then reads as such, not as a stress field of its own)."""
+    loaded = [load_panels(n)[0] for n in npzs]
     limits = {}
-    for i, (a, b) in enumerate(zip(pa, pb)):
-        if not is_damage(a["name"], a["label"]):
-            limits[i] = shared_limits([a["values"], b["values"]])
-    return render_saved(npz_a, png_a, limits), render_saved(npz_b, png_b, limits)
+    for i in range(min(len(p) for p in loaded)):
+        if not any(is_damage(p[i]["name"], p[i]["label"]) for p in loaded):
+            limits[i] = shared_limits([p[i]["values"] for p in loaded])
+    return [render_saved(n, png, limits) for n, png in zip(npzs, pngs)]
 
 
 # ---------------------------------------------------------------------------- setting figures
@@ -345,11 +415,43 @@ def draw_arrows(ax, tails, deltas, colour, label, size):
     ax.plot([], [], color=colour, lw=1.1, marker=">", markersize=4, label=label)  # legend entry
 
 
-def draw_setting(ax, cells, parts, loads=(), note=""):
+def _split_parts(parts, split):
+    """Boundary parts divided where a quantity changes along them (``split``: {label: (name,
+    function of the segment midpoints)}), e.g. the two friction planes of one contact part."""
+    out = []
+    for segs, colour, label, hatched in parts:
+        if not split or label not in split or segs.size == 0:
+            out.append((segs, colour, label, hatched))
+            continue
+        name, fn = split[label]
+        values = np.asarray(fn(segs.mean(1)), float)
+        for i, v in enumerate(np.unique(values)):
+            out.append((segs[values == v], colour, f"{label}, {name} = {v:g}", hatched,
+                        ("solid", "dashed", "dotted")[i % 3]))
+    return out
+
+
+def _free_edges(cells, parts):
+    """Outline edges of the mesh that no boundary part covers: traction-free."""
+    edges = boundary_edges(np.asarray(cells))
+    if not len(edges):
+        return edges
+    covered = [p[0].reshape(-1, 2, 2) for p in parts if p[0].size]
+    if not covered:
+        return edges
+    key = lambda segs: {tuple(sorted((tuple(np.round(a, 7)), tuple(np.round(b, 7)))))  # noqa: E731
+                        for a, b in segs}
+    taken = set().union(*(key(c) for c in covered))
+    return np.array([e for e in edges if tuple(sorted((tuple(np.round(e[0], 7)),
+                                                       tuple(np.round(e[1], 7))))) not in taken])
+
+
+def draw_setting(ax, cells, parts, loads=(), note="", split=None):
     """A thesis setting figure: the undeformed mesh, boundary parts (``parts``: (segments,
     colour, label, hatched)), load arrows (``loads``: ("f_N", segments, vectors, label) or
     ("f_B", points, vectors, label)); frames the axes on body, markers and arrows; ``note``
-    (e.g. why a load is not drawn) goes under the legend."""
+    (e.g. why a load is not drawn) goes under the legend. Outline edges no part covers are
+    drawn as traction-free; ``split`` divides a part where a quantity changes along it."""
     from matplotlib.collections import LineCollection
     cells = np.asarray(cells)
     triangle_edges(ax, cells, colour="0.6", zorder=1,
@@ -357,10 +459,15 @@ def draw_setting(ax, cells, parts, loads=(), note=""):
     size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
     inside = inside_test(cells)
     extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
-    for segs, colour, label, hatched in parts:
+    free = _free_edges(cells, parts)
+    if len(free):
+        ax.add_collection(LineCollection(free, colors="k", linewidths=1.4,  # solid: dashes
+                                         label="traction-free boundary", zorder=3))  # restart per facet
+    for segs, colour, label, hatched, *style in _split_parts(parts, split):
         if segs.size == 0:
             continue
         ax.add_collection(LineCollection(segs, colors=colour, linewidths=2.2,
+                                         linestyles=style[0] if style else "solid",
                                          label=mathtext(label), zorder=3))
         if hatched:
             ax.add_collection(LineCollection(support_hatch(segs, inside, size), colors=colour,

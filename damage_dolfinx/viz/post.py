@@ -222,7 +222,7 @@ def _run_zeta_star(png_path):
         return None
 
 
-def plot_mesh(geometry, path, title="", labels=None, loads=None):
+def plot_mesh(geometry, path, title="", labels=None, loads=None, split=None):
     """The undeformed mesh with its tagged boundary parts (thesis 'setting' figures): Gamma_D
     with clamp hatching, Gamma_C with the foundation drawn under it, load arrows (``loads``
     from :func:`setting_loads`: traction on the Gamma_N facets, body force inside), the legend
@@ -268,7 +268,7 @@ def plot_mesh(geometry, path, title="", labels=None, loads=None):
                   if label == labels[GAMMA_N] else label, hatched)
                  for segs, colour, label, hatched in drawn]
     fig, (ax,) = figstyle.new_figure(1, figstyle.data_aspect(cells), panel_width=5.0)
-    figstyle.draw_setting(ax, cells, drawn, arrows, note="; ".join(notes))
+    figstyle.draw_setting(ax, cells, drawn, arrows, note="; ".join(notes), split=split)
     figstyle.save(fig, path, title=figstyle.mathtext(title))
 
 

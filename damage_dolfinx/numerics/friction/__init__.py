@@ -1,5 +1,5 @@
 """Second-kind variational inequalities with Tresca friction (velocity step (2.67), increment
-step (2.187), dynamic step (3.94)): three interchangeable solvers of the same discrete problem
+step (2.187), dynamic step (3.94)): interchangeable solvers of the same discrete problem
 
     v in V:  a(v, w - v) + j(w) - j(v) >= l(w - v)  for all w in V,
     j(w) = sum_i m_i g_i |w_tau,i|   (nodal quadrature of int_{Gamma_C} g |w_tau| ds),
@@ -16,10 +16,13 @@ where V already carries v = 0 on Gamma_D and v.nu = 0 on Gamma_C (Dirichlet cond
   algebraic (:class:`AlgebraicResidual`: one matrix-vector product per iteration, no assembly);
   linear solves by Cholesky (PETSc's in serial, MUMPS in parallel), re-factorised only when the
   Jacobian changes (i.e. when the stick set changes).
-* :class:`Uzawa` (2.98) with two misprints corrected (docs/models.md, section 2.2):
+The reproduction adds two baselines (``reproduction/baselines.py``, registered with
+:func:`register_solver` when imported; not part of the installed library):
+
+* ``Uzawa`` (2.98) with two misprints corrected (docs/models.md, section 2.2):
   lambda_{s+1} = P(lambda_s + rho g v_tau),
   P(x) = x / max(1, |x|); the unregularised problem (needs Gamma_D: a must be coercive).
-* :class:`PenaltyDuality`: the Bermudez-Moreno iteration on the regularised problem, as in the
+* ``PenaltyDuality``: the Bermudez-Moreno iteration on the regularised problem, as in the
   thesis: Phi_eps(v_tau) = omega v_tau + q, q_{s+1} = (G - omega I)_lambda(v_tau + lambda q_s),
   lambda omega = 1/2.
 
@@ -37,7 +40,7 @@ The 2-D code paths are unchanged (2-D results identical bit for bit).
 
 Modules: ``nodes`` (FrictionProblem, ContactNodes), ``law`` (the nodal law in NumPy),
 ``residual`` (AlgebraicResidual), ``active_set`` (PrimalDualActiveSet), ``newton``
-(RegularisedNewton), ``baselines`` (Uzawa, PenaltyDuality); here the selection by parameters.
+(RegularisedNewton); here the selection by parameters (:data:`SOLVERS`, :func:`register_solver`).
 """
 from __future__ import annotations
 
@@ -46,19 +49,35 @@ import numpy as np
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.friction import law
 from damage_dolfinx.numerics.friction.active_set import PrimalDualActiveSet
-from damage_dolfinx.numerics.friction.baselines import ConstantOperator, PenaltyDuality, Uzawa
 from damage_dolfinx.numerics.friction.newton import (FAST_MAX_IT, FAST_PAUSE_STEPS, FRICTION_NEWTON, PDAS_MAX_IT, REFACTOR_ITS,
                      RegularisedNewton)
 from damage_dolfinx.numerics.friction.nodes import JACOBIAN_SHIFT, ContactNodes, FrictionProblem
 from damage_dolfinx.numerics.friction.residual import AlgebraicResidual
 
-__all__ = ["law", "AlgebraicResidual", "ConstantOperator", "ContactNodes", "FAST_MAX_IT",
+__all__ = ["law", "AlgebraicResidual", "ContactNodes", "FAST_MAX_IT",
            "FAST_PAUSE_STEPS", "FRICTION_NEWTON", "FrictionProblem", "JACOBIAN_SHIFT",
-           "PDAS_MAX_IT", "PenaltyDuality", "PrimalDualActiveSet", "REFACTOR_ITS",
-           "RegularisedNewton", "SOLVERS", "Uzawa", "iteration_counters", "make_solver",
-           "solver_from_parameters"]
+           "PDAS_MAX_IT", "PrimalDualActiveSet", "REFACTOR_ITS",
+           "RegularisedNewton", "SOLVERS", "iteration_counters", "make_solver",
+           "register_solver", "solver_from_parameters"]
 
-SOLVERS = ("newton", "uzawa", "penalty-duality")
+
+def _newton(problem, eps_reg, rho_uzawa, omega_pd, tol):
+    return RegularisedNewton(problem, eps_reg)
+
+
+#: the friction solvers by name: factory(problem, eps_reg, rho_uzawa, omega_pd, tol); Newton on
+#: the regularised law is the library's; others are registered (the reproduction's baselines)
+SOLVERS = {"newton": _newton}
+#: solvers that need a clamped part Gamma_D
+_NEEDS_CLAMP = set()
+
+
+def register_solver(name: str, factory, needs_clamp: bool = False):
+    """Make ``factory(problem, eps_reg, rho_uzawa, omega_pd, tol)`` the friction solver
+    ``name`` (the parameter ``friction_solver``); ``needs_clamp``: refused without Gamma_D."""
+    SOLVERS[name] = factory
+    if needs_clamp:
+        _NEEDS_CLAMP.add(name)
 
 #: Uzawa step (the thesis gives none) from log-spaced sweeps: at n = 16, k = 0.01 (all nodes slip)
 #: rho = 1, 10, 100 give 2 iterations per step (Newton solution to 2e-14), rho = 0.01 needs 25; at
@@ -89,21 +108,20 @@ def solver_from_parameters(problem: FrictionProblem, extra: dict, facet_tags, ga
     see rigid motions (dynamic)."""
     kind = extra["friction_solver"]
     comm = problem.msh.comm
-    if kind == "uzawa" and comm.allreduce(int(np.sum(facet_tags.values == gamma_D))) == 0:
-        raise InputError(f"{example_id}: the Uzawa friction solver needs a clamped part Gamma_D "
+    if kind in _NEEDS_CLAMP and comm.allreduce(int(np.sum(facet_tags.values == gamma_D))) == 0:
+        others = ", ".join(sorted(set(SOLVERS) - _NEEDS_CLAMP))
+        raise InputError(f"{example_id}: the {kind} friction solver needs a clamped part Gamma_D "
                          "(without it its operator is singular or its ||eps(v)|| stopping test "
-                         "cannot see rigid motions); use newton or penalty-duality")
+                         f"cannot see rigid motions); use {others}")
     return make_solver(kind, problem, extra["eps_reg"], extra.get("rho_uzawa", 1.0),
                        extra.get("omega_pd", 100.0), extra.get("friction_tol", 1e-6))
 
 
 def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: float,
                 omega_pd: float, tol: float = 1e-6):
-    """The friction solver selected by ``kind`` (newton | uzawa | penalty-duality)."""
-    if kind == "newton":
-        return RegularisedNewton(problem, eps_reg)
-    if kind == "uzawa":
-        return Uzawa(problem, rho_uzawa, tol=tol)
-    if kind == "penalty-duality":
-        return PenaltyDuality(problem, eps_reg, omega_pd, tol=tol)
-    raise InputError(f"unknown friction solver {kind!r}; choose one of {', '.join(SOLVERS)}")
+    """The friction solver registered as ``kind`` (newton, and those of register_solver)."""
+    if kind not in SOLVERS:
+        raise InputError(f"unknown friction solver {kind!r}; choose one of {', '.join(SOLVERS)}"
+                         " (the reproduction's uzawa and penalty-duality are registered by "
+                         "importing reproduction.baselines from the checkout)")
+    return SOLVERS[kind](problem, eps_reg, rho_uzawa, omega_pd, tol)

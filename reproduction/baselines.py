@@ -1,6 +1,11 @@
 """The two thesis baselines for the friction VI, on the unregularised (Uzawa) and regularised
 (penalty-duality) problem: a constant operator factorised once, nodal multipliers updated with
-NumPy, stopped when ||v_{s+1} - v_s||_V <= tol ||v_{s+1}||_V (thesis: tol = 1e-6)."""
+NumPy, stopped when ||v_{s+1} - v_s||_V <= tol ||v_{s+1}||_V (thesis: tol = 1e-6).
+
+They serve the reproduction (Tables 2.2-2.4 compare them with Newton on the regularised law)
+and are not part of the installed library: importing this module registers them as the
+friction solvers ``uzawa`` and ``penalty-duality`` (``friction_solver`` parameter). The command
+line imports it when named in ``DAMAGE_DOLFINX_PLUGINS`` (``make`` and the tests do so)."""
 from __future__ import annotations
 
 import math
@@ -15,6 +20,7 @@ from damage_dolfinx.numerics.constitutive import eps as strain
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.solvers import ConvergenceError, set_default_options, spd_direct
 from damage_dolfinx.numerics.friction import law
+from damage_dolfinx.numerics.friction import register_solver
 from damage_dolfinx.numerics.friction.nodes import ContactNodes, FrictionProblem
 
 class ConstantOperator:
@@ -176,3 +182,17 @@ class PenaltyDuality(_IterativeFrictionSolver):
         scale = np.where(stick, 2.0 / (1.0 + g / (om * eps_)),
                          (2.0 * size - g / om) / np.where(stick, 1.0, size))
         return 2.0 * om * (x - scale[:, None] * x)
+
+
+def _uzawa(problem, eps_reg, rho_uzawa, omega_pd, tol):
+    return Uzawa(problem, rho_uzawa, tol=tol)
+
+
+def _penalty_duality(problem, eps_reg, rho_uzawa, omega_pd, tol):
+    return PenaltyDuality(problem, eps_reg, omega_pd, tol=tol)
+
+
+# Uzawa's operator is singular without Gamma_D (quasistatic), and its ||eps(v)|| stopping test
+# cannot see rigid motions (dynamic): it needs a clamped part
+register_solver("uzawa", _uzawa, needs_clamp=True)
+register_solver("penalty-duality", _penalty_duality)

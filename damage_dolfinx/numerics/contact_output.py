@@ -1,0 +1,222 @@
+"""Contact quantities as outputs: what the foundation does to the body on Gamma_C, per step.
+
+One object for every model with a contact role: the run attaches it to its model
+(``ContactOutput.for_model``), which adds history.csv columns and XDMF fields to the model.
+
+Nodal contact forces. With the vertex (trapezoidal) rule on Gamma_C, node i of Gamma_C carries
+the weight m_i = int_{Gamma_C} phi_i ds, the lumped unit normal nu_i (int nu phi_i ds,
+normalised) and the force F_i the foundation exerts on the body:
+
+* normal compliance (a ``pressure`` p = p_nu(u.nu - gap) >= 0 given):  F_i = -int p nu phi_i ds
+  (with the quadrature of the models' contact terms, PRESSURE_DEGREE);
+* bilateral contact and friction (a ``residual`` R(w) = a(v, w) - l(w) of the step without its
+  contact constraint): F_i = R(phi_i) = int_{Gamma_C} sigma nu . phi_i ds, the reaction of the
+  constraint (normal) and the friction force (tangential) together; nodes of the clamped part
+  Gamma_D are left out of the forces (their rows hold the clamping reaction).
+
+The pressure is p_i = -F_i.nu_i / m_i, the friction traction F_tau,i / m_i with
+F_tau = F - (F.nu) nu. history.csv gets, per step:
+
+    contact_normal_force     sum_i -F_i.nu_i (the normal resultant, > 0 in compression)
+    contact_force_x, _y(, _z) sum_i F_i (the resultant the foundation exerts on the body)
+    contact_length / _area   sum of m_i where p_i > 0 (normal compliance), all of Gamma_C
+                             (bilateral: in contact by construction)
+    contact_penetration      max_i (u_i.nu_i - gap)_+ (bilateral: max_i |u_i.nu_i|, zero up to
+                             round-off)
+    friction_force           2-D: sum_i F_i.tau_i, tau = (-nu_2, nu_1); 3-D: |sum_i F_tau,i|
+    slip_length / slip_area  sum of m_i where |v_tau,i| > eps_reg (the regularised law slides)
+
+and the XDMF series the P1 fields ``contact_pressure`` and ``friction_traction`` (zero off
+Gamma_C).
+"""
+from __future__ import annotations
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from damage_dolfinx import compat
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
+from damage_dolfinx.numerics.contact import (NODAL_QUADRATURE, NODAL_QUADRATURE_3D,  # noqa: F401
+                                             normal_compliance_pressure)
+
+
+#: quadrature degree of the normal compliance force: that of the models' contact terms, so that
+#: sum_i F_i is the force the scheme applies (the pressure has kinks inside facets)
+PRESSURE_DEGREE = 2
+
+
+def _assemble(form):
+    """Owned entries of an assembled vector (ghost contributions added)."""
+    vec = compat.create_vector(form)
+    with vec.localForm() as local:
+        local.set(0.0)
+    compat.assemble_vector(vec, form)
+    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    return vec.getArray().copy()
+
+
+class ContactOutput:
+    """The contact quantities of one stepper (module docstring)."""
+
+    def __init__(self, stepper, pressure=None, gap=0.0, residual=None, slip_rate=None,
+                 eps_slip=None):
+        msh, self.comm = stepper.mesh, stepper.comm
+        self.dim = msh.topology.dim
+        self.u, self.V = stepper.u, stepper.u.function_space
+        tags = stepper.data.geometry.facet_tags
+        rule = NODAL_QUADRATURE if self.dim == 2 else NODAL_QUADRATURE_3D
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags, metadata=rule)
+        w, n = ufl.TestFunction(self.V), ufl.FacetNormal(msh)
+        bs, owned = self.dim, self.V.dofmap.index_map.size_local
+        self.m = _assemble(compat.form(w[0] * ds(GAMMA_C))).reshape(-1, bs)[:, 0]
+        clamped = _assemble(compat.form(w[0] * ds(GAMMA_D))).reshape(-1, bs)[:, 0]
+        self.gap, self.compliance = float(gap), pressure is not None
+        self.nodes = np.flatnonzero((self.m > 0) & ((clamped == 0) | self.compliance))
+        self.length = self.comm.allreduce(float(self.m[:owned].sum()), op=MPI.SUM)
+        normal = _assemble(compat.form(ufl.dot(n, w) * ds(GAMMA_C))).reshape(-1, bs)
+        normal = normal[self.nodes]
+        self.nu = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        dsq = ufl.Measure("ds", domain=msh, subdomain_data=tags,
+                          metadata={"quadrature_degree": PRESSURE_DEGREE})
+        force = -pressure * ufl.dot(n, w) * dsq(GAMMA_C) if self.compliance else residual
+        self._force = force if isinstance(force, tuple) else compat.form(force)
+        self.slip_rate, self.eps_slip = slip_rate, eps_slip
+        size = "length" if self.dim == 2 else "area"
+        self.columns = (["contact_normal_force"] + [f"contact_force_{c}" for c in "xyz"[:bs]]
+                        + [f"contact_{size}", "contact_penetration"])
+        if slip_rate is not None:
+            self.columns += ["friction_force", f"slip_{size}"]
+        self._size = size
+        Z = compat.scalar_p1(msh)
+        self.pressure = fem.Function(Z, name="contact_pressure")
+        self._z_nodes = self._matching_nodes(Z, owned)
+        self.fields = [self.pressure]
+        if slip_rate is not None:
+            self.traction = fem.Function(self.V, name="friction_traction")
+            self.fields.append(self.traction)
+
+    def _matching_nodes(self, Z, owned):
+        """Owned dofs of the scalar P1 space Z at the contact nodes (matched by coordinates)."""
+        xz = np.round(Z.tabulate_dof_coordinates()[:Z.dofmap.index_map.size_local], 12)
+        xv = np.round(self.V.tabulate_dof_coordinates()[:owned][self.nodes], 12)
+        lookup = {tuple(x): i for i, x in enumerate(xz)}
+        found = np.array([lookup.get(tuple(x), -1) for x in xv], dtype=np.int64)
+        self._z_found = found >= 0  # a vertex owned by another rank in Z: its owner writes it
+        return found[self._z_found]
+
+    @classmethod
+    def attach(cls, stepper, **kwargs):
+        """Add the contact columns and fields to ``stepper`` (its ``scalars()`` and
+        ``update_output()`` report them); nothing when its Gamma_C is empty. Call it at the end
+        of the stepper's constructor."""
+        tags = stepper.data.geometry.facet_tags
+        if not stepper.comm.allreduce(int(np.sum(tags.values == GAMMA_C)), op=MPI.SUM):
+            return None
+        out = cls(stepper, **kwargs)
+        stepper.extra_history_columns = list(stepper.extra_history_columns) + out.columns
+        stepper.output_fields = list(stepper.output_fields) + out.fields
+        scalars, update = stepper.scalars, stepper.update_output
+        stepper.scalars = lambda: {**scalars(), **out.scalars()}
+        stepper.update_output = lambda: (update(), out.update())
+        stepper.contact_output = out
+        return out
+
+    @classmethod
+    def for_model(cls, stepper):
+        """Attach the contact outputs that fit ``stepper`` (a model): normal compliance when it
+        has a contact pressure (``contact_pressure()``), the reaction and friction of its
+        friction problem (``friction_problem``: a, l, v), the reaction of its linear mechanical
+        solve (``mech``: a, L of a bilateral Gamma_C); nothing otherwise."""
+        pressure = stepper.contact_pressure() if hasattr(stepper, "contact_pressure") else None
+        if pressure is not None:
+            gap = float(stepper.params.extra.get("gap", 0.0))
+            return cls.attach(stepper, pressure=pressure, gap=gap)
+        problem = getattr(stepper, "friction_problem", None)
+        if problem is not None:
+            return cls.attach(stepper, residual=ufl.action(problem.a, problem.v) - problem.l,
+                              slip_rate=problem.v,
+                              eps_slip=float(stepper.params.extra.get("eps_reg", 1e-9)))
+        mech = getattr(stepper, "mech", None)
+        if "bilateral" in getattr(stepper, "contact_roles", ()) and hasattr(mech, "a") \
+                and hasattr(mech, "L"):
+            return cls.attach(stepper, residual=(mech.a, mech.L))
+        return None
+
+    def _nodal(self):
+        """(F (nodes, dim), p (nodes,), F_tau (nodes, dim)) on the owned contact nodes."""
+        F = self._forces().reshape(-1, self.dim)[self.nodes]
+        Fn = np.sum(F * self.nu, axis=1)
+        return F, -Fn / self.m[self.nodes], F - Fn[:, None] * self.nu
+
+    def _forces(self):
+        """Owned entries of the nodal force vector: an assembled linear form, or A u - b of a
+        compiled (a, L) pair (a linear solve's forms, without its boundary conditions)."""
+        if not isinstance(self._force, tuple):
+            return _assemble(self._force)
+        a, L = self._force
+        if not hasattr(self, "_matrix"):
+            self._matrix = compat.create_matrix(a)
+        A = self._matrix
+        A.zeroEntries()
+        compat.assemble_matrix(A, a, [])
+        A.assemble()
+        r = A.createVecLeft()
+        A.mult(compat.petsc_vec(self.u), r)
+        b = compat.create_vector(L)
+        with b.localForm() as local:
+            local.set(0.0)
+        compat.assemble_vector(b, L)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        r.axpy(-1.0, b)
+        out = r.getArray().copy()
+        r.destroy()
+        b.destroy()
+        return out
+
+    def scalars(self) -> dict:
+        F, p, F_tau = self._nodal()
+        m = self.m[self.nodes]
+        owned = self.V.dofmap.index_map.size_local
+        un = np.sum(self.u.x.array[:owned * self.dim].reshape(-1, self.dim)[self.nodes]
+                    * self.nu, axis=1)
+        if self.compliance:
+            in_contact, penetration = p > 0, np.maximum(un - self.gap, 0.0)
+        else:
+            in_contact, penetration = None, np.abs(un)
+        sums = [np.sum(p * m), *F.sum(axis=0), np.sum(m[in_contact]) if self.compliance else 0.0]
+        if self.slip_rate is not None:
+            v = self.slip_rate.x.array[:owned * self.dim].reshape(-1, self.dim)[self.nodes]
+            v_tau = v - np.sum(v * self.nu, axis=1)[:, None] * self.nu
+            sliding = np.linalg.norm(v_tau, axis=1) > self.eps_slip
+            if self.dim == 2:
+                tau = np.column_stack([-self.nu[:, 1], self.nu[:, 0]])
+                sums += [np.sum(F_tau * tau), np.sum(m[sliding])]
+            else:
+                sums += [*F_tau.sum(axis=0), np.sum(m[sliding])]
+        sums = self.comm.allreduce(np.array(sums, float), op=MPI.SUM)
+        peak = self.comm.allreduce(float(penetration.max()) if penetration.size else 0.0,
+                                   op=MPI.MAX)
+        d = self.dim
+        size = sums[d + 1] if self.compliance else self.length  # bilateral: all of Gamma_C
+        out = {"contact_normal_force": sums[0], f"contact_{self._size}": size,
+               "contact_penetration": peak,
+               **{f"contact_force_{c}": sums[1 + i] for i, c in enumerate("xyz"[:d])}}
+        if self.slip_rate is not None:
+            friction = sums[d + 2] if d == 2 else float(np.linalg.norm(sums[d + 2:2 * d + 2]))
+            out.update({"friction_force": float(friction), f"slip_{self._size}": sums[-1]})
+        return {key: float(value) for key, value in out.items()}
+
+    def update(self):
+        """The contact_pressure (and friction_traction) fields of the current state."""
+        F, p, F_tau = self._nodal()
+        self.pressure.x.array[:] = 0.0
+        self.pressure.x.array[self._z_nodes] = p[self._z_found]
+        self.pressure.x.scatter_forward()
+        if self.slip_rate is not None:
+            values = self.traction.x.array.reshape(-1, self.dim)
+            values[:] = 0.0
+            values[self.nodes] = F_tau / self.m[self.nodes][:, None]
+            self.traction.x.scatter_forward()
