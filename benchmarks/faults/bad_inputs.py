@@ -618,6 +618,13 @@ def _api_cases(case, none, copy, only_user, mesh, run, conv, sweep_base):
          fast=False)
     case("sweep into a folder named by a dangling link", "sweep",
          [*sweep_base, "--set", "kappa=1,2", "--out", OUT], dangling)
+    # -- a non-finite damage source fails the run on every model, whatever the solver path
+    case("2.2-ex1 --set lam_u=1e300 (obstacle damage step)", "state",
+         ["run", "2.2-ex1", "--n", "4", "--k", "0.02", "--T", "0.1", "--no-figures", "--quiet",
+          "--set", "lam_u=1e300", "--out", OUT], expect="failed", fast=False)
+    case("2.4-ex1 --set lam_u=1e300 (obstacle damage step)", "state",
+         ["run", "2.4-ex1", "--n", "4", "--k", "0.25", "--T", "0.5", "--no-figures", "--quiet",
+          "--set", "lam_u=1e300", "--out", OUT], expect="failed", fast=False)
     # -- mesh files and weak messages
     case("--mesh mixed triangles and quadrilaterals", "mesh",
          ["run", "2.1-ex2a", "--mesh", "m.msh", "--out", OUT], mesh("mixed"))
