@@ -210,20 +210,24 @@ def _check_boundaries(boundaries, info):
     if not isinstance(boundaries, dict) or not boundaries:
         raise InputError("boundaries must be a dict {role: tag or [tags]}, got "
                          f"{_shown(boundaries)}")
-    allowed = ("clamped", "traction") + tuple(info.contact_roles)
+    allowed = tuple(info.boundary_roles())  # the model's declaration (Model.boundary_roles)
     for role, tags in boundaries.items():
         if role not in allowed:
             raise InputError(f"boundaries: role {role!r} is not one of model {info.id}'s: "
                              f"{', '.join(allowed)}")
-        listed = [tags] if is_real(tags) else tags
-        if isinstance(listed, (str, bytes, dict)) or not hasattr(listed, "__iter__"):
-            raise InputError(f"boundaries[{role!r}] must be a facet tag or a list of tags, got "
-                             f"{_shown(tags)}")
+        listed = [tags] if is_real(tags) or isinstance(tags, str) else tags
+        if isinstance(listed, (bytes, dict)) or not hasattr(listed, "__iter__"):
+            raise InputError(f"boundaries[{role!r}] must be a facet tag, a gmsh physical name "
+                             f"or a list of these, got {_shown(tags)}")
         listed = list(listed)
         if not listed:
             raise InputError(f"boundaries[{role!r}] lists no facet tag")
         for tag in listed:
-            whole(f"boundaries[{role!r}] (a facet tag)", tag, low=0)
+            if isinstance(tag, str):  # a gmsh physical name: looked up on the mesh (meshes.py)
+                if not tag.strip():
+                    raise InputError(f"boundaries[{role!r}]: an empty physical name")
+                continue
+            whole(f"boundaries[{role!r}] (a facet tag or a gmsh physical name)", tag, low=0)
     return set(boundaries)
 
 

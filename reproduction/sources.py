@@ -54,8 +54,8 @@ class Figures:
         self.sources = []
         for name, mode in (("figures", "full"), ("figures-quick", "quick")):
             index = _load_json(results / name / "index.json")
-            if index:
-                self.sources.append((results / name, index, mode))
+            if index:  # the mode the runs were made in (a quick run may sit in figures/)
+                self.sources.append((results / name, index, index.get("mode", mode)))
         self.results = results
 
     def find(self, file):

@@ -48,7 +48,8 @@ LoadBuilder = Callable[[object, object], object]
 
 @dataclass
 class ProblemData:
-    """Everything a stepper needs: the example's geometry, data and time grid."""
+    """What a model is built from: the run's geometry (mesh and facet tags), data, time grid,
+    loads, initial damage, damage law and model-specific builders."""
     example_id: str
     geometry: object
     params: ModelParameters

@@ -42,6 +42,7 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
 from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -52,7 +53,7 @@ from damage_dolfinx.parameters import ModelParameters
 VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
 
 
-class DynamicKelvinVoigt(Model):
+class DynamicKelvinVoigt(NormalComplianceScalars, Model):
     """Problem VP^{hk} of Section 3.1."""
 
     id = "3.1"
@@ -125,7 +126,7 @@ class DynamicKelvinVoigt(Model):
         self._vm_strain_expr = compat.expression(von_mises(eps(self.u)), Q)
         self.figure_fields = {"von_mises_strain": (self.von_mises_strain,
                                                    "von Mises norm of the strain [-]")}
-        self._scalar_setup(ds(GAMMA_C))
+        self._contact_setup(ds(GAMMA_C))
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises, self.von_mises_strain]
         self.timings = {"damage": 0.0, "velocity": 0.0, "stability": self.stability.get("time_s", 0.0)}
 
@@ -167,11 +168,6 @@ class DynamicKelvinVoigt(Model):
                 "stability": self.stability}
 
     # -- scalars: ||v||_L2, max |u| at the nodes, RMS penetration on Gamma_C
-    def _scalar_setup(self, dsC):
-        self._penetration = compat.form(
-            ufl.max_value(ufl.dot(self.u, self.n_facet) - self.gap, 0.0) ** 2 * dsC)
-        self._contact_length = compat.assemble_scalar(fem.Constant(self.mesh, 1.0) * dsC, self.comm)
-
     def u_max(self) -> float:
         """max over the nodes of |u_n| (the L-shape comparison of Example 3)."""
         owned = self.u.function_space.dofmap.index_map.size_local
@@ -185,15 +181,8 @@ class DynamicKelvinVoigt(Model):
         M.mult(v, y)
         out["v_L2"] = float(np.sqrt(abs(v.dot(y))))
         out["u_max"] = self.u_max()
-        length = self._contact_length
-        pen = compat.assemble_scalar(self._penetration, self.comm) if length > 0 else 0.0
-        out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
+        out["penetration_rms"] = self.penetration_rms()
         return out
-
-    def contact_pressure(self):
-        """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
-        from damage_dolfinx.numerics.contact import normal_compliance_pressure
-        return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations if self.damage else 0,

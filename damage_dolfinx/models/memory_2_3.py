@@ -35,6 +35,7 @@ from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
 from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -52,7 +53,7 @@ def mech_contact_amg():
     return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
 
 
-class ViscoelasticMemoryContact(Model):
+class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
     """Problem VP^{hk} of Section 2.3."""
 
     id = "2.3"
@@ -131,9 +132,7 @@ class ViscoelasticMemoryContact(Model):
         self.von_mises = fem.Function(Q, name="von_mises")
         self._vm_expr = compat.expression(
             von_mises(total_stress(self.u, self.memory.M, p.E, p.nu)), Q)
-        self._penetration = compat.form(
-            ufl.max_value(ufl.dot(self.u, self.n_facet) - self.gap, 0.0) ** 2 * ds(GAMMA_C))
-        self._contact_length = compat.form(fem.Constant(msh, 1.0) * ds(GAMMA_C))
+        self._contact_setup(ds(GAMMA_C))
         sigma = total_stress(self.u, self.memory.M, p.E, p.nu)
         self._stress_sq = compat.form(ufl.inner(sigma, sigma) * ufl.dx)
         self.output_fields = [self.u, self.zeta, self.von_mises]
@@ -163,17 +162,8 @@ class ViscoelasticMemoryContact(Model):
         """Base scalars, the RMS penetration (u.nu - gap)_+ over Gamma_C and ||sigma_n||_Q."""
         out = super().scalars()
         out["stress_L2"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
-        if not isinstance(self._contact_length, float):  # |Gamma_C|, assembled once
-            self._contact_length = compat.assemble_scalar(self._contact_length, self.comm)
-        length = self._contact_length
-        pen = compat.assemble_scalar(self._penetration, self.comm)
-        out["penetration_rms"] = float(np.sqrt(pen / length)) if length > 0 else 0.0
+        out["penetration_rms"] = self.penetration_rms()
         return out
-
-    def contact_pressure(self):
-        """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
-        from damage_dolfinx.numerics.contact import normal_compliance_pressure
-        return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)
 
     def iteration_totals(self) -> dict:
         return {"damage_ksp": self.damage.iterations, "snes": self.mech.iterations,

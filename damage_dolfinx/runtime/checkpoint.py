@@ -283,9 +283,9 @@ def fingerprint(ex, stepper) -> dict:
         out["zeta0"] = f"function of x in [{digest[0]:.9g}, {digest[1]:.9g}]"
     else:
         out["zeta0"] = float(z0)
-    out["boundaries"] = repr(sorted((str(k), v if isinstance(v, (int, np.integer)) else
-                                     sorted(map(int, v)))
-                                    for k, v in (ex.boundaries or {}).items()))
+    def tags(v):  # facet tags or gmsh physical names, one or a list
+        return sorted(map(str, [v] if isinstance(v, (int, np.integer, str)) else v))
+    out["boundaries"] = repr(sorted((str(k), tags(v)) for k, v in (ex.boundaries or {}).items()))
     out["irreversible"] = bool(data.irreversible)
     out["reading"] = getattr(ex, "reading", None)
     out["builders"] = repr(sorted((str(k), repr(v) if not callable(v) else "function")

@@ -5,33 +5,24 @@ the initial state and after every step. What a step writes is in records.py."""
 from __future__ import annotations
 
 import math
-import signal
 import sys
 import time
 from pathlib import Path
 
-import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx import departures
 from damage_dolfinx.numerics.contact_output import ContactOutput
+from damage_dolfinx.numerics.solvers import ConvergenceError
+from damage_dolfinx.parameters import InputError
 from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.runtime.cases import resolve
-from damage_dolfinx.numerics.damage import fast_path_counts
-from damage_dolfinx.parameters import InputError
-from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
-                                              claim_folder, previous_run)
-from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
-from damage_dolfinx.numerics.solvers import ConvergenceError
-
-
-from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  # noqa: F401
-                                           Progress, solver_step, state_problem)
-from damage_dolfinx.runtime.figures import auto_amplification, draw_figure  # noqa: F401
-
+from damage_dolfinx.runtime.guards import Progress, solver_step
 from damage_dolfinx.runtime.records import RunRecords
+from damage_dolfinx.runtime.runfolder import (RunLock, check_mesh_file, claim_folder,
+                                              previous_run)
 from damage_dolfinx.runtime.runner import CHECKPOINT_SECONDS, Step
-
+from damage_dolfinx.runtime.signals import StopSignals
 
 class Run(RunRecords):
     """One run into a folder: set up (:meth:`prepare`), then :meth:`steps`."""

@@ -3,29 +3,19 @@
 XDMF fields, checkpoints, figures, the per-step collective checks and the interrupt."""
 from __future__ import annotations
 
-import math
 import signal
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.numerics.damage import fast_path_counts
-from damage_dolfinx.parameters import InputError
-from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
-                                              claim_folder, previous_run)
-from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
 from damage_dolfinx.numerics.solvers import ConvergenceError
-
-
-from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  # noqa: F401
-                                           Progress, solver_step, state_problem)
-from damage_dolfinx.runtime.figures import auto_amplification, draw_figure  # noqa: F401
-
-
+from damage_dolfinx.runtime import checkpoint, io
+from damage_dolfinx.runtime.figures import draw_figure
+from damage_dolfinx.runtime.guards import state_problem
+from damage_dolfinx.runtime.runfolder import add_to_manifest
+from damage_dolfinx.runtime.signals import RunInterrupted
 
 class ColumnError(RuntimeError):
     """A model reported a scalar that no history column takes, or left a declared one out."""

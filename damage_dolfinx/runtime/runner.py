@@ -24,29 +24,15 @@ runfolder.RunLock refuses a second run into a folder where one is live.
 """
 from __future__ import annotations
 
-import math
-import signal
-import sys
-import time
-from pathlib import Path
-
-import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx.runtime import checkpoint, io
-from damage_dolfinx.runtime.cases import resolve  # noqa: F401 (studies)
-from damage_dolfinx.runtime.records import ColumnError  # noqa: F401
-from damage_dolfinx.numerics.damage import fast_path_counts
-from damage_dolfinx.parameters import InputError
-from damage_dolfinx.runtime.runfolder import (RunLock, add_to_manifest, check_mesh_file,
-                                              claim_folder, previous_run)
-from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted, StopSignals  # noqa: F401 (cli.py)
-from damage_dolfinx.numerics.solvers import ConvergenceError
-
-
-from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  # noqa: F401
-                                           Progress, solver_step, state_problem)
+# names other modules take from here (the command line, the studies, the figures' tests)
+from damage_dolfinx.runtime.cases import resolve  # noqa: F401
 from damage_dolfinx.runtime.figures import auto_amplification, draw_figure  # noqa: F401
+from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  # noqa: F401
+                                           Progress, solver_step)
+from damage_dolfinx.runtime.records import ColumnError  # noqa: F401
+from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted  # noqa: F401
 
 #: default wall-time interval between checkpoints (seconds)
 CHECKPOINT_SECONDS = 120.0
