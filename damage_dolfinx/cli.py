@@ -11,7 +11,11 @@ with status 3 after writing what was finished (summary.json "failed"); an output
 (disk full, I/O error, output folder deleted) exits with status 4; SIGTERM, SIGINT or SIGUSR1
 stop a run at the end of the current step with a checkpoint, exit status 128 + signal number
 (143, 130, 138); a repeat of the signal within 5 s is ignored, a later one ends the process
-at once (signals.StopSignals).
+at once (signals.StopSignals). Outside a run's time loop (set-up, a convergence study, a sweep
+between points) SIGTERM and SIGINT stop the command with one line, the status recorded and the
+same exit status. Any other exception (the user's own code) is one line, exit status 3. Under
+MPI every rank ends with the same status, also when only one rank failed
+(runtime/collective.py).
 """
 from __future__ import annotations
 

@@ -138,7 +138,7 @@ def check_problem(problem):
         raise InputError(f"params must be a dict of changes or a ModelParameters "
                          f"(model_defaults({info.id!r})), got {type(params).__name__}")
     if isinstance(params, ModelParameters):
-        _check_parameters_of(params, info)
+        _check_parameters_of(params, info, problem.damage_law is not None)
     elif isinstance(params, dict):
         params = {_key("params", key): _param_value(key, value) for key, value in params.items()}
     for name in ("traction", "body_force"):
@@ -252,14 +252,20 @@ def _param_value(key, value):
                      f"{_shown(value)} ({type(value).__name__})")
 
 
-def _check_parameters_of(params, info):
+def _check_parameters_of(params, info, own_law):
     """A ModelParameters built for another model (model_defaults('3.3') given to a 2.2
-    problem) lacks this model's data."""
+    problem) lacks this model's data, or carries data the model does not read (allowed only as
+    the data of one's own damage law)."""
     own = info.defaults()
     missing = sorted(set(own.extra) - set(params.extra))
     if missing:
         raise InputError(f"params: a ModelParameters without model {info.id}'s data "
                          f"({', '.join(missing)}); start from model_defaults({info.id!r})")
+    foreign = sorted(set(params.extra) - set(own.extra))
+    if foreign and not own_law:
+        raise InputError(f"params: a ModelParameters with data model {info.id} does not read "
+                         f"({', '.join(foreign[:6])}{', ...' if len(foreign) > 6 else ''}): "
+                         f"another model's? start from model_defaults({info.id!r})")
 
 
 # ---------------------------------------------------------------------------- with the mesh

@@ -86,17 +86,21 @@ def test_sweep_refusal_on_one_point_is_collective(tmp_path):
 def test_sigterm_to_one_rank_of_a_sweep_ends_every_rank(tmp_path):
     out = tmp_path / "sw"
     cmd = ["mpirun", "-n", "2", sys.executable, "-m", "damage_dolfinx.cli", "sweep", "2.1-ex1",
-           "--set", "kappa=0.5,1", "--n", "10", "--T", "3", "--out", str(out),
+           "--set", "kappa=0.5,1", "--set", "lam_u_plus=1", "--n", "10", "--T", "5",
+           "--out", str(out),
            "--no-figures"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=ENV)
     deadline = time.monotonic() + 120
     pid = None
-    while time.monotonic() < deadline and pid is None:  # rank 1's point has started
-        time.sleep(0.5)
+    while time.monotonic() < deadline and pid is None and proc.poll() is None:
+        time.sleep(0.2)  # rank 1's point has started
         if (out / "point_1" / "summary.json").exists():
             pid = _rank_pid(proc.pid, 1)
-    assert pid, "point 1 never started"
+    if pid is None:
+        proc.kill()
+        stdout, stderr = proc.communicate()
+    assert pid, f"point 1 never started: {stdout}{stderr}"
     os.kill(pid, signal.SIGTERM)
     sent = time.monotonic()
     stdout, stderr = proc.communicate(timeout=60)

@@ -31,6 +31,8 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 RUN = ["run", "2.1-ex1", "--n", "5", "--k", "0.25", "--no-figures", "--quiet"]
 STUDY = ["converge", "2.1-ex1", "--ref-n", "10", "--ref-k", "0.125", "--n", "5",
          "--k", "0.25", "0.5", "--quiet"]
+SWEEP = ["sweep", "2.1-ex1", "--n", "5", "--k", "0.25", "--no-figures", "--quiet", "--set",
+         "kappa=1,2"]
 #: a folder name (in the case's own working folder)
 OUT = "o"
 
@@ -57,7 +59,18 @@ def gmsh_mesh(path, kind):
     gmsh = _gmsh()  # the package's gmsh session (the tests run in one process)
     gmsh.model.add("m")
     occ = gmsh.model.occ
-    if kind == "1d":
+    if kind == "mixed":  # a triangle half and a quadrilateral half
+        a, b = occ.addRectangle(0, 0, 0, 1, 1), occ.addRectangle(1, 0, 0, 1, 1)
+        occ.fragment([(2, a)], [(2, b)])
+        occ.synchronize()
+        gmsh.model.mesh.setRecombine(2, b)
+        curves = [t for _, t in gmsh.model.getEntities(1)]
+        gmsh.model.addPhysicalGroup(2, [a, b], 10)
+        gmsh.model.addPhysicalGroup(1, curves[:1], 1)
+        gmsh.model.addPhysicalGroup(1, curves[1:], 2)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.25)
+        gmsh.model.mesh.generate(2)
+    elif kind == "1d":
         a, b = occ.addPoint(0, 0, 0), occ.addPoint(1, 0, 0)
         line = occ.addLine(a, b)
         occ.synchronize()
@@ -195,8 +208,10 @@ def _cases():
     conv = ["converge", "2.1-ex1", "--ref-n", "10", "--ref-k", "0.125", "--quiet"]
     c = []
 
-    def case(id_, cls, args, setup=none, expect="refused", fast=True):
-        c.append(dict(id=id_, cls=cls, args=args, setup=setup, expect=expect, fast=fast))
+    def case(id_, cls, args, setup=none, expect="refused", fast=True, code=None, verify=None,
+             ranks=1):
+        c.append(dict(id=id_, cls=cls, args=args, setup=setup, expect=expect, fast=fast,
+                      code=code, verify=verify, ranks=ranks))
 
     # -- 1. every option honoured or refused
     case("single-dash -n -k", "options", ["run", "2.1-ex1", "-n", "5", "-k", "0.5", "--out", OUT])
@@ -370,7 +385,298 @@ def _cases():
     case("3.3-ex1 at k = 3.1 k_max", "ranges",
          ["run", "3.3-ex1", "--n", "8", "--k", "3.5", "--T", "7", "--no-figures", "--quiet",
           "--out", OUT], fast=False)
+    sweep_base = ["sweep", "2.1-ex1", "--n", "5", "--k", "0.25", "--no-figures", "--quiet"]
+    _api_cases(case, none, copy, only_user, mesh, run, conv, sweep_base)
     return c
+
+
+# ---------------------------------------------------------------------------- the API, sweeps,
+# converge, restarts and MPI
+#: what every API case starts from (a tiny 2.1 problem of one's own: 2 steps on 8 x 2 cells)
+API_PRELUDE = '''
+import sys
+import numpy as np
+import ufl
+from mpi4py import MPI
+import damage_dolfinx as dd
+from damage_dolfinx.geometries.rectangle import rectangle, side
+
+
+def mesh(comm, n):
+    return rectangle(comm, (0.0, 0.0), (2.0, 0.5), 4 * n, n,
+                     {1: side(0, 0.0), 2: side(0, 2.0), 3: side(1, 0.0)})
+
+
+def problem(**changes):
+    data = dict(model="2.1", mesh=mesh, n=2, T=0.02, k=0.01,
+                boundaries={"clamped": 1, "traction": 2, "bilateral": 3},
+                traction=lambda x, t: ufl.as_vector((10.0 * t, 0.0)))
+    data.update(changes)
+    return dd.Problem(**data)
+
+
+def run(p, out="o", **kw):
+    kw.setdefault("figures", False)
+    kw.setdefault("progress", False)
+    return dd.run(p, out, **kw)
+'''
+
+#: runs a case's code as a user's script would, the exceptions of the API mapped to the command
+#: line's exit statuses (rank 0 prints the one line); any other exception is a traceback
+API_HARNESS = '''
+import sys
+from mpi4py import MPI
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.numerics.solvers import ConvergenceError
+from damage_dolfinx.runtime.io import OutputError
+CODE = open(sys.argv[1]).read()
+say = (lambda text: print(text, file=sys.stderr, flush=True)) if MPI.COMM_WORLD.rank == 0 \\
+    else (lambda text: None)
+try:
+    exec(compile(CODE, "case.py", "exec"), {"__name__": "__main__"})
+except InputError as exc:
+    say(f"damage-dolfinx: error: {exc}")
+    sys.exit(2)
+except (ConvergenceError, OutputError) as exc:
+    say(f"damage-dolfinx: failed: {exc}")
+    sys.exit(3 if isinstance(exc, ConvergenceError) else 4)
+except Exception as exc:
+    if hasattr(exc, "exit_status"):
+        say(f"damage-dolfinx: {exc}")
+        sys.exit(exc.exit_status)
+    raise
+'''
+
+
+def _api_cases(case, none, copy, only_user, mesh, run, conv, sweep_base):
+    def api(id_, cls, code, expect="refused", setup=none, fast=True, verify=None, ranks=1,
+            first=None):
+        if first is not None:  # an earlier run of the API, made before the case
+            def setup(work, bases, code=API_PRELUDE + first):
+                status, err = _api_in_process(code, work)
+                if status != 0:
+                    raise RuntimeError(f"the earlier run of the case failed: {err}")
+                return []
+        case(id_, cls, ["<api>"], setup, expect, fast, code=API_PRELUDE + code, verify=verify,
+             ranks=ranks)
+
+    # -- the API's bad input (validation.py): refused before any file, naming the argument
+    api("traction with 3 components on a 2-D mesh", "api",
+        "run(problem(traction=lambda x, t: ufl.as_vector((t, 0.0, 0.0))))")
+    api("scalar traction", "api", "run(problem(traction=lambda x, t: 5.0 * t))")
+    api("traction as a tuple", "api", "run(problem(traction=lambda x, t: (t, 0.0)))")
+    api("body force with 3 components", "api",
+        "run(problem(body_force=lambda x, t: ufl.as_vector((t, 0.0, 0.0))))")
+    api("traction not callable", "api", "run(problem(traction=5.0))")
+    api("damage law returning a vector", "api",
+        "run(problem(damage_law=dd.DamageLaw(lambda e, z, p: ufl.as_vector((z, z)))))")
+    api("damage law returning text", "api",
+        "run(problem(damage_law=dd.DamageLaw(lambda e, z, p: 'fast')))")
+    api("damage law using NumPy on UFL", "api",
+        "run(problem(damage_law=dd.DamageLaw(lambda e, z, p: np.sqrt(z))))")
+    api("damage_law a bare function", "api", "run(problem(damage_law=lambda e, z, p: z))")
+    api("params E=[...]", "api", "run(problem(params={'E': [1.0, 2.0]}))")
+    api("params E='abc'", "api", "run(problem(params={'E': 'abc'}))")
+    api("params E=-1", "api", "run(problem(params={'E': -1.0}))")
+    api("params nu=0.7", "api", "run(problem(params={'nu': 0.7}))")
+    api("params a text", "api", "run(problem(params='E=5'))")
+    api("model_defaults('3.3') to a 2.1 problem", "api",
+        "run(problem(params=dd.model_defaults('3.3')))")
+    api("model_defaults('2.2') to a 2.1 problem", "api",
+        "run(problem(model='2.4', boundaries={'clamped': 1, 'traction': 2, 'tresca': 3}, "
+        "params=dd.model_defaults('2.2')))")
+    api("traction but no traction role", "api",
+        "run(problem(boundaries={'clamped': 1, 'bilateral': 3}))")
+    api("irreversible='no'", "api", "run(problem(irreversible='no'))")
+    api("allow_unstable='yes'", "api", "run(problem(allow_unstable='yes'))")
+    api("zeta0=1.5", "api", "run(problem(zeta0=1.5))")
+    api("zeta0='abc'", "api", "run(problem(zeta0='abc'))")
+    api("zeta0(x) outside [zeta*, 1]", "api", "run(problem(zeta0=lambda x: 2.0 + 0 * x[0]))")
+    api("zeta0(x) of the wrong shape", "api",
+        "run(problem(zeta0=lambda x: np.ones((2, x.shape[1]))))")
+    api("k negative", "api", "run(problem(k=-0.01))")
+    api("k above T", "api", "run(problem(k=0.5))")
+    api("T=nan", "api", "run(problem(T=float('nan')))")
+    api("T=0", "api", "run(problem(T=0))")
+    api("T=1e-300 below k (zero steps)", "api", "run(problem(T=1e-300))")
+    api("n=2.5", "api", "run(problem(n=2.5))")
+    api("n=0", "api", "run(problem(n=0))")
+    api("mesh family without n", "api", "run(problem(n=None))")
+    api("model '9.9'", "api", "run(problem(model='9.9'))")
+    api("model 2.1 (a float)", "api", "run(problem(model=2.1))")
+    api("boundaries {'clamped': 'left'}", "api",
+        "run(problem(boundaries={'clamped': 'left', 'traction': 2}))")
+    api("boundary role unknown", "api",
+        "run(problem(boundaries={'glued': 1, 'traction': 2}))")
+    api("boundary tag not on the mesh", "api",
+        "run(problem(boundaries={'clamped': 7, 'traction': 2}))")
+    api("name with a slash", "api", "run(problem(name='a/b'))")
+    api("mesh=42", "api", "run(problem(mesh=42, n=None))")
+    api("mesh a missing file", "api", "run(problem(mesh='missing.msh', n=None))")
+    api("mesh a folder", "api", "run(problem(mesh='.', n=None))")
+    api("T=np.int64(1) (a NumPy number)", "api",
+        "run(problem(T=np.int64(1), k=np.float64(0.25)))", expect="ok", fast=False)
+    api("params E=np.float64 (a NumPy number)", "api",
+        "run(problem(params={'E': np.float64(2e4)}))", expect="ok", fast=False)
+    api("run(out=None)", "api", "run(problem(), out=None)")
+    api("run(restart='yes')", "api", "run(problem(), restart='yes')")
+    api("run(checkpoint_every=0)", "api", "run(problem(), checkpoint_every=0)")
+    api("run(n=-1)", "api", "run(problem(), n=-1)")
+    api("converge(n=2)", "api",
+        "dd.converge(problem(), 'o', n=2, k=[0.01], ref_n=4, ref_k=0.005)")
+    api("converge(k=0.01)", "api",
+        "dd.converge(problem(), 'o', n=[2], k=0.01, ref_n=4, ref_k=0.005)")
+    api("converge(ref_n=2.5)", "api",
+        "dd.converge(problem(), 'o', n=[2], k=[0.01], ref_n=2.5, ref_k=0.005)")
+    api("converge(n=[0])", "api",
+        "dd.converge(problem(), 'o', n=[0], k=[0.01], ref_n=4, ref_k=0.005)")
+    api("sweep(max_points=0)", "api", "dd.sweep(problem(), 'o', {'kappa': [1.0]}, max_points=0)")
+    api("sweep(figures='no')", "api", "dd.sweep(problem(), 'o', {'kappa': [1.0]}, figures='no')")
+    api("read_mesh of a folder", "api", "dd.read_mesh('.')")
+    api("read_mesh(42)", "api", "dd.read_mesh(42)")
+    api("read_mesh(dim=5)", "api", "dd.read_mesh('m.msh', dim=5)", setup=mesh("ok"))
+    api("read_mesh of a mixed triangle/quad file", "api", "dd.read_mesh('m.msh')",
+        setup=mesh("mixed"))
+    api("from_gmsh(dim=5)", "api", "dd.from_gmsh(dim=5)")
+    # -- restarts: a fingerprint of what defines the run, checked by every resume
+    first = "run(problem(T=0.02), checkpoint_every=1)\n"
+    api("restart with a traction 100 times larger", "restart", first=first, code=
+        "run(problem(T=0.04, traction=lambda x, t: ufl.as_vector((1000.0 * t, 0.0))), "
+        "restart=True)", fast=False)
+    api("restart with another damage law", "restart", first=first, code=
+        "run(problem(T=0.04, damage_law=dd.DamageLaw(lambda e, z, p: -z, 'own')), "
+        "restart=True)", fast=False)
+    api("restart with irreversibility on", "restart", first=first, code=
+        "run(problem(T=0.04, irreversible=True), restart=True)", fast=False)
+    api("restart with the boundary parts swapped", "restart", first=first, code=
+        "run(problem(T=0.04, boundaries={'clamped': 2, 'traction': 1, "
+        "'bilateral': 3}), restart=True)", fast=False)
+    api("restart with a body force added", "restart", first=first, code=
+        "run(problem(T=0.04, body_force=lambda x, t: ufl.as_vector((0.0, -t))), "
+        "restart=True)", fast=False)
+    api("restart with zeta0 changed", "restart", first=first, code=
+        "run(problem(T=0.04, zeta0=0.5), restart=True)", fast=False)
+    api("restart, the same problem to a larger T (control)", "restart", first=first, code=
+        "s = run(problem(T=0.04), restart=True)\nassert s['steps_done'] == 4, s",
+        expect="ok", fast=False)
+
+    def steps_done(n):
+        def verify(work):
+            try:
+                s = json.loads((work / OUT / "summary.json").read_text())
+            except (OSError, ValueError) as exc:
+                return f"summary.json unreadable ({exc})"
+            if s.get("status") != "completed" or s.get("steps_done") != n or not s.get("final"):
+                return (f"summary says {s.get('status')}, steps_done {s.get('steps_done')}, "
+                        f"final {'set' if s.get('final') else 'null'}; {n} steps are on disk")
+            return None
+        return verify
+
+    def summary_cut(work, bases):
+        shutil.copytree(bases["run"], work / OUT)
+        text = (work / OUT / "summary.json").read_text()
+        (work / OUT / "summary.json").write_text(text[:len(text) // 3])
+        return []
+
+    def summary_zero(work, bases):
+        shutil.copytree(bases["run"], work / OUT)
+        s = json.loads((work / OUT / "summary.json").read_text())
+        s.update(status="failed", error="cannot write fields_final.png: No space left on device")
+        (work / OUT / "summary.json").write_text(json.dumps(s))
+        return []
+
+    case("completed run, summary.json cut short, --restart", "restart",
+         [*run, "--restart", "--out", OUT], summary_cut, "ok", verify=steps_done(4))
+    case("run failed at its last figure (disk full), --restart", "restart",
+         [*run, "--restart", "--out", OUT], summary_zero, "ok", verify=steps_done(4))
+    case("--restart --reading evidence of a literal run", "restart",
+         [*run, "--T", "2", "--reading", "evidence", "--restart", "--out", OUT], copy("run"))
+    # -- zero steps and time grids
+    case("--T 1e-300 (zero steps)", "ranges", ["run", "2.1-ex1", "--n", "5", "--T", "1e-300",
+                                                "--out", OUT])
+    case("converge --T 1e-300", "ranges", [*conv, "--n", "5", "--k", "0.25", "--T", "1e-300",
+                                           "--out", OUT])
+    case("sweep --T 1e-300", "sweep", [*sweep_base, "--T", "1e-300", "--set", "kappa=1,2",
+                                       "--out", OUT])
+    # -- sweeps under the run-folder rules
+    case("sweep into a finished run", "sweep", [*sweep_base, "--set", "kappa=1,2", "--out", OUT],
+         copy("run"))
+    case("sweep into a convergence study", "sweep",
+         [*sweep_base, "--set", "kappa=1,2", "--out", OUT], copy("study"))
+    case("sweep into a folder of the user's notes", "sweep",
+         [*sweep_base, "--set", "kappa=1,2", "--out", OUT], only_user(["notes.txt"]))
+    case("sweep with a user's file in point_1/", "sweep",
+         [*sweep_base, "--set", "kappa=1,2", "--out", OUT], point_user_file)
+    case("run into a sweep folder", "sweep", [*run, "--out", OUT], copy("sweep"))
+    case("run --overwrite into a sweep folder", "sweep", [*run, "--overwrite", "--out", OUT],
+         copy("sweep"))
+    case("converge into a sweep folder", "sweep",
+         [*conv, "--n", "5", "--k", "0.25", "--out", OUT], copy("sweep"))
+    case("sweep of 9e6 points", "sweep",
+         [*sweep_base, "--set", "kappa=" + ",".join(str(i + 1) for i in range(3000)),
+          "--set", "lam_D=" + ",".join(str(0.001 * (i + 1)) for i in range(3000)),
+          "--out", OUT])
+    case("sweep --max-points 0", "sweep", [*sweep_base, "--set", "kappa=1,2", "--max-points",
+                                           "0", "--out", OUT])
+    case("sweep --set kappa=nan", "sweep", [*sweep_base, "--set", "kappa=1,nan", "--out", OUT])
+    case("sweep unknown parameter", "sweep", [*sweep_base, "--set", "bogus=1,2", "--out", OUT])
+    case("sweep with a failing point", "sweep",
+         [*sweep_base, "--set", "lam_u_plus=1,1e300", "--out", OUT], expect="failed",
+         fast=False)
+    case("sweep into a folder named by a dangling link", "sweep",
+         [*sweep_base, "--set", "kappa=1,2", "--out", OUT], dangling)
+    # -- a non-finite damage source fails the run on every model, whatever the solver path
+    case("2.2-ex1 --set lam_u=1e300 (obstacle damage step)", "state",
+         ["run", "2.2-ex1", "--n", "4", "--k", "0.02", "--T", "0.1", "--no-figures", "--quiet",
+          "--set", "lam_u=1e300", "--out", OUT], expect="failed", fast=False)
+    case("2.4-ex1 --set lam_u=1e300 (obstacle damage step)", "state",
+         ["run", "2.4-ex1", "--n", "4", "--k", "0.25", "--T", "0.5", "--no-figures", "--quiet",
+          "--set", "lam_u=1e300", "--out", OUT], expect="failed", fast=False)
+    # -- mesh files and weak messages
+    case("--mesh mixed triangles and quadrilaterals", "mesh",
+         ["run", "2.1-ex2a", "--mesh", "m.msh", "--out", OUT], mesh("mixed"))
+    case("--out a dangling symbolic link", "folder", [*run, "--out", OUT], dangling)
+    case("--out a symbolic link loop", "folder", [*run, "--out", OUT], link_loop)
+    # -- MPI: a refusal or a failure on one rank ends every rank, one line
+    case("2 ranks: sweep with a user's file in point_1/", "mpi",
+         [*sweep_base, "--set", "kappa=1,2", "--out", OUT], point_user_file, fast=False,
+         ranks=2)
+    case("2 ranks: sweep of 9e6 points", "mpi",
+         [*sweep_base, "--set", "kappa=" + ",".join(str(i + 1) for i in range(3000)),
+          "--set", "lam_D=" + ",".join(str(0.001 * (i + 1)) for i in range(3000)),
+          "--out", OUT], fast=False, ranks=2)
+    case("2 ranks: --mesh mixed cell types", "mpi",
+         ["run", "2.1-ex2a", "--mesh", "m.msh", "--out", OUT], mesh("mixed"), fast=False,
+         ranks=2)
+    api("2 ranks: a load raising on rank 1 only", "mpi",
+        "def load(x, t):\n    if MPI.COMM_WORLD.rank == 1:\n        raise RuntimeError('rank 1')\n"
+        "    return ufl.as_vector((t, 0.0))\nrun(problem(traction=load))", fast=False, ranks=2)
+    api("2 ranks: a damage law raising on rank 1 at set-up", "mpi",
+        "calls = []\ndef law(e, z, p):\n    calls.append(1)\n"
+        "    if MPI.COMM_WORLD.rank == 1 and len(calls) > 1:\n        raise ZeroDivisionError('r1')\n"
+        "    return -z\nrun(problem(damage_law=dd.DamageLaw(law, 'own')))", fast=False, ranks=2)
+    api("2 ranks: a traction of 3 components", "mpi",
+        "run(problem(traction=lambda x, t: ufl.as_vector((t, 0.0, 0.0))))", fast=False, ranks=2)
+    api("3 ranks: a load raising on rank 1 only", "mpi",
+        "def load(x, t):\n    if MPI.COMM_WORLD.rank == 1:\n        raise RuntimeError('rank 1')\n"
+        "    return ufl.as_vector((t, 0.0))\nrun(problem(traction=load))", fast=False, ranks=3)
+
+
+def point_user_file(work, bases):
+    shutil.copytree(bases["sweep"], work / OUT)
+    shutil.rmtree(work / OUT / "point_1")
+    user_files(work / OUT / "point_1", ["notes.txt"])
+    return [f"{OUT}/point_1/notes.txt"]
+
+
+def dangling(work, bases):
+    os.symlink(work / "nowhere", work / OUT)
+    return []
+
+
+def link_loop(work, bases):
+    os.symlink(work / OUT, work / OUT)
+    return []
 
 
 CASES = _cases()
@@ -384,17 +690,27 @@ def make_bases(root: Path, runner) -> dict:
     runner(["run", "2.4-ex1", "--n", "4", "--k", "0.25", "--T", "0.5", "--no-figures",
             "--quiet", "--out", str(bases["run24"])], root)
     runner([*STUDY, "--out", str(bases["study"])], root)
+    bases["sweep"] = root / "base_sweep"
+    runner([*SWEEP, "--out", str(bases["sweep"])], root)
     return bases
 
 
 #: seconds a case may take (a case still running then counts as "no end")
 TIMEOUT = [300]
+#: the same under mpirun (a rank waiting for another that failed is the hang looked for)
+MPI_TIMEOUT = 60
 
 
-def _subprocess(args, cwd):
+def _subprocess(args, cwd, ranks=1, script=None):
+    """The command line (or, with ``script``, the API harness on the case's code) in ``cwd``,
+    under mpirun with ``ranks`` > 1 (a job still running after the timeout is a hang)."""
+    command = [sys.executable, *(script or ["-m", "damage_dolfinx.cli", *args])]
+    if ranks > 1:
+        command = ["mpirun", "-n", str(ranks), *command]
+    timeout = TIMEOUT[0] if ranks == 1 else min(TIMEOUT[0], MPI_TIMEOUT)
     try:
-        proc = subprocess.run([sys.executable, "-m", "damage_dolfinx.cli", *args], cwd=cwd,
-                              env=ENV, capture_output=True, text=True, timeout=TIMEOUT[0])
+        proc = subprocess.run(command, cwd=cwd, env=ENV, capture_output=True, text=True,
+                              timeout=timeout)
     except subprocess.TimeoutExpired as exc:
         err = exc.stderr.decode(errors="replace") if isinstance(exc.stderr, bytes) else \
             (exc.stderr or "")
@@ -403,10 +719,12 @@ def _subprocess(args, cwd):
 
 
 def snapshot(work: Path) -> dict:
-    """name (relative to the case's folder) -> sha256 of every file."""
+    """name (relative to the case's folder) -> sha256 of every file (but the run lock
+    ``.lock``, the package's bookkeeping, which a job ended by MPI_Abort leaves behind: it
+    never blocks a later run)."""
     out = {}
     for path in sorted(work.rglob("*")):
-        if path.is_file():
+        if path.is_file() and path.name != ".lock":
             out[str(path.relative_to(work))] = hashlib.sha256(path.read_bytes()).hexdigest()
     return out
 
@@ -431,8 +749,8 @@ def classify(case, status, stderr, before, after, user, work) -> dict:
         pass
     if status is None:
         outcome = f"no end within {TIMEOUT[0]} s"
-    elif "Traceback" in stderr:
-        outcome = "traceback"
+    elif "Traceback" in stderr or status not in (0, 2, 3, 4, 130, 143):
+        outcome = "traceback or crash"
     elif touched:
         outcome = "user file touched"
     elif bad_json:
@@ -450,22 +768,86 @@ def classify(case, status, stderr, before, after, user, work) -> dict:
         outcome = f"other (exit {status}, {len(ours)} line(s), {len(changed)} file(s) changed)"
     message = ours[0] if ours else (lines[0] if lines else "")
     return {"id": case["id"], "class": case["cls"],
-            "command": "damage-dolfinx " + " ".join(case["args"]), "exit_status": status,
+            "command": (f"mpirun -n {case['ranks']} " if case.get("ranks", 1) > 1 else "")
+            + ("python (API): " + case["code"].split("return dd.run(p, out, **kw)\n")[-1].strip()
+               if case.get("code") else "damage-dolfinx " + " ".join(
+                   a if len(a) < 60 else a[:40] + "..." for a in case["args"])),
+            "exit_status": status,
             "message": message, "files_before": sorted(before), "files_after": sorted(after),
             "user_files_touched": touched, "invalid_json": bad_json, "outcome": outcome,
             "expected": case["expect"], "pass": outcome == case["expect"]}
 
 
+def _api_in_process(code, cwd):
+    """(exit status, stderr) of the API harness run on ``code`` in this process (the tests)."""
+    import contextlib
+    import io
+    import traceback
+    err, here = io.StringIO(), os.getcwd()
+    os.chdir(cwd)
+    try:
+        with contextlib.redirect_stderr(err):
+            try:
+                exec(compile(API_HARNESS.replace("CODE = open(sys.argv[1]).read()",
+                                                 "CODE = _CODE"), "harness.py", "exec"),
+                     {"__name__": "__main__", "_CODE": code})
+                status = 0
+            except SystemExit as exc:
+                status = exc.code
+            except Exception:  # noqa: BLE001 - recorded as a traceback
+                err.write(traceback.format_exc())
+                status = 1
+    finally:
+        os.chdir(here)
+    return status, err.getvalue()
+
+
 def run_case(case, bases, root: Path, runner=_subprocess) -> dict:
+    """One case in a folder of its own under ``root``. ``runner(args, cwd)`` runs the command
+    line (tests: in the test's process); the API cases and the MPI cases always run in a
+    process of their own (a hang must not stop the table)."""
     work = Path(tempfile.mkdtemp(dir=root))
     user = case["setup"](work, bases)
     before = snapshot(work)
     start = time.perf_counter()
-    status, _, stderr = runner(case["args"], work)
+    if case.get("code") is not None and case.get("ranks", 1) == 1 and runner is not _subprocess:
+        status, stderr = _api_in_process(case["code"], work)
+    elif case.get("code") is not None:
+        scripts = Path(tempfile.mkdtemp(dir=root))
+        (scripts / "harness.py").write_text(API_HARNESS)
+        (scripts / "case.py").write_text(case["code"])
+        status, _, stderr = _subprocess(None, work, case.get("ranks", 1),
+                                        [str(scripts / "harness.py"), str(scripts / "case.py")])
+    elif case.get("ranks", 1) > 1:
+        status, _, stderr = _subprocess(case["args"], work, case["ranks"])
+    else:
+        status, _, stderr = runner(case["args"], work)
     result = classify(case, status, stderr, before, snapshot(work), user, work)
+    if result["outcome"] == "ok" and case.get("verify"):
+        wrong = case["verify"](work)
+        if wrong:
+            result.update(outcome="silently wrong result", message=wrong,
+                          **{"pass": case["expect"] == "silently wrong result"})
     result["seconds"] = round(time.perf_counter() - start, 1)
     shutil.rmtree(work, ignore_errors=True)
     return result
+
+
+def kind(r) -> str:
+    """The case's result in the classes of defects looked for: clean (the expected outcome),
+    hang, traceback or crash, silently wrong result or ignored input (a run that completed
+    where a refusal or a failure was due, or a wrong summary), user file lost or overwritten,
+    other."""
+    if r["pass"]:
+        return "clean"
+    if r["outcome"].startswith("no end"):
+        return "hang"
+    if r["outcome"] in ("traceback or crash", "user file touched"):
+        return {"user file touched": "user file lost or overwritten"}.get(r["outcome"],
+                                                                          r["outcome"])
+    if r["outcome"] in ("ok", "warned", "silently wrong result"):
+        return "silently wrong result or ignored input"
+    return "other"
 
 
 def write_tables(results, out: Path):
@@ -475,9 +857,17 @@ def write_tables(results, out: Path):
     for r in results:
         counts[r["outcome"]] = counts.get(r["outcome"], 0) + 1
     passed = sum(r["pass"] for r in results)
-    lines = ["# Bad input: what the command line does with it", "",
+    kinds = {}
+    for r in results:
+        kinds[kind(r)] = kinds.get(kind(r), 0) + 1
+    lines = ["# Bad input: what the command line and the API do with it", "",
              f"{len(results)} cases, {passed} with the expected outcome. Outcomes: "
-             + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + ".", "",
+             + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())) + ". By class of "
+             "defect: " + ", ".join(f"{k} {v}" for k, v in sorted(kinds.items())) + ".", "",
+             "Cases marked (API) run a user's script (the API's exceptions mapped to the command "
+             "line's exit statuses by a small harness: InputError 2, a solver failure 3, an "
+             "output error 4; any other exception is a traceback); cases under mpirun end as a "
+             f"hang when still running after {MPI_TIMEOUT} s.", "",
              "Written by `python benchmarks/faults/bad_inputs.py`; each case runs in a folder "
              "of its own (`o` is the output folder). *refused*: exit status 2, one line, no "
              "file written or changed; *failed*: exit status 3, one line, summary.json "
@@ -501,9 +891,13 @@ def main():
     parser.add_argument("--only", nargs="+", help="case ids (substrings)")
     parser.add_argument("--out", default=str(HERE), help="folder of the two tables")
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds per case")
+    parser.add_argument("--start", type=int, default=0,
+                        help="skip the first START cases (e.g. 93: only the API, sweep, "
+                             "converge, restart and MPI cases)")
     args = parser.parse_args()
     TIMEOUT[0] = args.timeout
-    cases = [c for c in CASES if not args.only or any(s in c["id"] for s in args.only)]
+    cases = [c for c in CASES[args.start:]
+             if not args.only or any(s in c["id"] for s in args.only)]
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         bases = make_bases(root, lambda a, cwd: _check(_subprocess(a, cwd)))
@@ -514,7 +908,10 @@ def main():
                   f"{r['id']}: {r['message'][:110]}", flush=True)
             results.append(r)
     counts, passed = write_tables(results, Path(args.out))
-    print(f"{len(results)} cases, {passed} as expected: {counts}")
+    kinds = {}
+    for r in results:
+        kinds[kind(r)] = kinds.get(kind(r), 0) + 1
+    print(f"{len(results)} cases, {passed} as expected: {counts}; by class: {kinds}")
 
 
 def _check(result):

@@ -7,6 +7,8 @@ or the obstacle problem over K^h = {zeta_star <= zeta <= 1} solved by PETSc SNES
 """
 from __future__ import annotations
 
+import math
+
 import ufl
 from dolfinx import fem
 from petsc4py import PETSc
@@ -174,9 +176,15 @@ class DamageStep:
                 bl.set(0.0)
             compat.assemble_vector(self.b, self.L)
             self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        # a source that is not finite (an overflow of phi) would be clipped to the bounds by the
+        # obstacle solvers and give a finite, wrong zeta: the run fails instead, on every model
+        norm = self.b.norm()  # collective: every rank decides alike
+        if not math.isfinite(norm):
+            raise ConvergenceError("the damage source phi(eps, zeta) is not finite (NaN or Inf): "
+                                   "the model's data overflow (e.g. a lam_u of 1e300)")
         # the reduced systems are solved to CG accuracy relative to ||l||: an absolute
         # tolerance below that is unreachable on large domains (3.3 Ex. 1, (0,6)^2)
-        atol = max(self._atol, self.atol_rel * self.b.norm()) if self.atol_rel else self._atol
+        atol = max(self._atol, self.atol_rel * norm) if self.atol_rel else self._atol
         if atol != self._atol_set:  # PETSc is told only when it changes
             self.snes.snes.setTolerances(atol=atol)
             self._atol_set = atol

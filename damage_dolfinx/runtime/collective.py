@@ -159,7 +159,8 @@ def mark(folder, exc, rank=None, kind=None):
             summary = {}
     except (OSError, ValueError):
         summary = {}
-    if summary.get("status") not in (None, "running"):
+    unfinished = (None, "running") + (("incomplete", "completed") if kind == "sweep" else ())
+    if summary.get("status") not in unfinished:  # the run recorded its own outcome
         return
     _, _, status = classify(exc)
     schema = {"run": "damage-dolfinx/summary/v1", "study": "damage-dolfinx/convergence/v1",

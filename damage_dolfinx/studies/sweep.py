@@ -244,6 +244,8 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
         summary = {"schema": SCHEMA, "case": ex.id, "status": status, "grid": grid,
                    "points": len(points), "completed": len(done), "failed": failed,
                    "errors": {str(i): why for i, why in sorted(failures.items())},
+                   **({"error": f"{len(failed)} of {len(points)} points failed"} if failed
+                      else {}),
                    "pending": [r["point"] for r in rows if r["status"] != "completed"],
                    "ran": todo, "mpi_size": comm.size, "points_on_all_ranks": together,
                    "csv": "sweep.csv", "plot": "sweep.png" if plot and done else None,
