@@ -64,8 +64,9 @@ def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="er
     label at every level (h + k of every cell), the axes named with their quantities and the
     error's norms, the fitted slope of all cells drawn (dashed, with its value), the slope in h
     at the smallest k dotted, and a title naming the problem and the norm."""
-    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
     from damage_dolfinx.viz import figstyle
+    tk = figstyle.ticker()
+    FixedLocator, NullFormatter, NullLocator = tk.FixedLocator, tk.NullFormatter, tk.NullLocator
     pyplot = figstyle.plt()
     fig, ax = pyplot.subplots(figsize=(COLUMN_WIDTH_IN, PLOT_HEIGHT_IN))
     ks = sorted({r["k"] for r in rows}, reverse=True)
@@ -106,13 +107,13 @@ def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="er
     ax.grid(True, which="major", alpha=0.3)
     ax.legend(fontsize=6, loc="lower right", framealpha=0.85)
     figstyle.log_tick_labels(ax)
-    from matplotlib.ticker import FixedFormatter
+    FixedFormatter = tk.FixedFormatter
     ax.xaxis.set_major_locator(FixedLocator(levels))
     ax.xaxis.set_major_formatter(FixedFormatter(labels))
     ax.xaxis.set_minor_formatter(NullFormatter())
     lo, hi = ax.get_ylim()
     if hi / lo < 10:  # less than a decade: a label at every tick of the error axis
-        from matplotlib.ticker import FuncFormatter, LogLocator
+        FuncFormatter, LogLocator = tk.FuncFormatter, tk.LogLocator
         ax.yaxis.set_minor_locator(LogLocator(subs=np.arange(1, 10)))
         ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
@@ -121,5 +122,4 @@ def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="er
     fig.tight_layout()
     ax.set_title(f"{name}\nconvergence in {norms}\nreference $n$ = {ref_n}, $k$ = {ref_k:g}",
                  fontsize=7.5)
-    fig.savefig(path, dpi=300, bbox_inches="tight")
-    pyplot.close(fig)
+    figstyle.save_as_laid_out(fig, path)

@@ -101,6 +101,18 @@ def plt():
     return pyplot
 
 
+def ticker():
+    """matplotlib's tick locators and formatters (for plots laid out outside this module)."""
+    import matplotlib.ticker
+    return matplotlib.ticker
+
+
+def save_as_laid_out(fig, path, dpi=300):
+    """Save a figure whose layout and title its caller set (tight bounding box), and close it."""
+    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    plt().close(fig)
+
+
 def data_aspect(xy) -> float:
     """Height / width of the body's bounding box (sizes the figure to the content)."""
     pts = np.asarray(xy).reshape(-1, 2)
