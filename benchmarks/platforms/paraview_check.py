@@ -6,7 +6,8 @@ For each run folder, ParaView's Python (``pvpython``, Debian package python3-par
 ``xvfb-run`` when there is no display) opens ``fields.xdmf`` with ParaView's XDMF reader
 (``platforms/pv_read.py``). This script then checks, against the run's own files:
 
-* time steps: every XDMF time is a time of ``history.csv`` (to 1e-12), each appears once and in
+* time steps: every XDMF time is a time of ``history.csv`` (to 1e-12) or a step of the run's time
+  grid (a run that writes a history row every few steps), each appears once and in
   increasing order (a restarted run too: ``make check-paraview`` includes one), and the last one
   is the run's ``t_final`` (summary.json);
 * arrays at the last time: u and zeta (point data) and von Mises (cell data) equal the gathered
@@ -80,7 +81,10 @@ def check(folder: Path, out: Path) -> dict:
     with open(folder / "history.csv") as f:
         hist_t = np.array([float(r["t"]) for r in csv.DictReader(f)])
     times = np.array(seen["times"])
-    times_ok = bool(len(times) and all(np.abs(hist_t - t).min() < 1e-12 for t in times)
+    # a time of the run's grid: a history.csv row, or a step between rows (history_every > 1)
+    on_grid = [np.abs(hist_t - t).min() < 1e-12
+               or abs(t / summary["k"] - round(t / summary["k"])) < 1e-6 for t in times]
+    times_ok = bool(len(times) and all(on_grid)
                     and abs(times[-1] - summary["t_final"]) < 1e-12
                     and np.all(np.diff(times) > 0))  # one series, each time once (restarts)
     final = np.load(folder / "fields_final.npz")
