@@ -26,7 +26,10 @@ MECHANISM = ("fields.xdmf is the index of the whole run: a restart from step N w
              "of every segment (relative paths), with the times from t_N on taken from the newest "
              "segment only")
 
-_XI = "{http://www.w3.org/2001/XInclude}include"
+def _is_xinclude(tag) -> bool:
+    """An XInclude element, whatever namespace URI the writer declared (DOLFINx 0.5 writes
+    http://www.w3.org/2001/XInclude, 0.9 and later https://...)."""
+    return isinstance(tag, str) and tag.endswith("}include") and "XInclude" in tag
 
 
 def _mesh_parts(root):
@@ -52,7 +55,7 @@ def time_steps(path) -> dict:
         for grid in collection.findall("Grid"):
             grid = copy.deepcopy(grid)
             for i, child in enumerate(list(grid)):
-                if child.tag == _XI:
+                if _is_xinclude(child.tag):
                     grid.remove(child)
                     for j, part in enumerate(mesh):
                         grid.insert(i + j, copy.deepcopy(part))
