@@ -109,6 +109,18 @@ def _dataset(folder, item):
         return np.asarray(f[key][()])
 
 
+def _tensor_2d_columns(values) -> list:
+    """The columns of a 2 x 2 tensor written as 9 components: DOLFINx 0.5 pads it as a 3 x 3
+    matrix (xx, xy, 0, yx, yy, 0, 0, 0, 0), later versions append the zeros (xx, xy, yx, yy, 0,
+    ...); told apart by where the zeros are."""
+    zero = ~np.any(values != 0.0, axis=0)
+    if zero[2] and zero[5:].all() and not zero[4]:
+        return [0, 1, 3, 4]
+    if zero[4:].all():
+        return [0, 1, 2, 3]
+    return [0, 1, 3, 4]
+
+
 class Series:
     """A run's ``fields.xdmf`` read with h5py: ``times``, ``names`` and ``field(name, t)``."""
 
@@ -143,7 +155,7 @@ class Series:
         if attribute.get("AttributeType") == "Vector" and values.shape[1] == 3 and gdim == 2:
             values = values[:, :2]
         if attribute.get("AttributeType") == "Tensor" and values.shape[1] == 9 and gdim == 2:
-            values = values[:, [0, 1, 3, 4]]
+            values = values[:, _tensor_2d_columns(values)]
         key = np.round(coords, 10)
         key, first = np.unique(key, axis=0, return_index=True)  # shared nodes written once each
         coords, values = coords[first], values[first]
