@@ -345,8 +345,8 @@ STRETCHED_CMAP = DAMAGE_CMAP
 def suptitle_on_top(fig, text):
     """The figure title just above the axes' titles (equal-aspect axes shrink inside their
     slot; a default suptitle would float over an empty band)."""
-    fastdraw.layout_draw(fig)
-    renderer = fig.canvas.get_renderer()
+    renderer = fig.canvas.get_renderer()  # no draw first: get_tightbbox applies the aspect
+    # and updates the ticks itself (a full draw here doubled the text layout work)
     inv = fig.transFigure.inverted()
     top = max(ax.get_tightbbox(renderer).transformed(inv).y1 for ax in fig.axes)
     fig.suptitle(text, y=top + 0.01, va="bottom")
