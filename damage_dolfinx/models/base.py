@@ -21,6 +21,7 @@ initial state is the shared one (zeta_0, u_0 = v_0 = 0) plus :meth:`Model.start`
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -44,22 +45,6 @@ DAMAGE_A = dict(kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.
 
 #: a load builder: (x = SpatialCoordinate, t = fem.Constant) -> UFL vector
 LoadBuilder = Callable[[object, object], object]
-
-
-@dataclass
-class ProblemData:
-    """What a model is built from: the run's geometry (mesh and facet tags), data, time grid,
-    loads, initial damage, damage law and model-specific builders."""
-    example_id: str
-    geometry: object
-    params: ModelParameters
-    time: TimeGrid
-    body_force: Optional[LoadBuilder] = None
-    traction: Optional[LoadBuilder] = None
-    zeta0: Union[float, Callable] = 1.0
-    builders: dict = field(default_factory=dict)  # problem-specific UFL builders, e.g. g(x)
-    damage_law: Optional[object] = None  # laws.DamageLaw (None: the thesis law of params.variant)
-    irreversible: bool = False           # zeta_n <= zeta_{n-1} (the damage step's upper bound)
 
 
 @dataclass(frozen=True)
@@ -151,11 +136,13 @@ class Model:
         return [SubStep(name, getattr(self, name), kind, prefix)
                 for name, kind, prefix in self.scheme if getattr(self, name, None) is not None]
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data):
+        if not isinstance(data.params, ModelParameters):  # a Problem built by hand
+            data = dataclasses.replace(data, params=data.parameters())
         self.data, self.params = data, data.params
         self.mesh = data.geometry.mesh
         self.comm = self.mesh.comm
-        self.context = SolveContext(example=data.example_id)
+        self.context = SolveContext(example=data.id)
         self.n, self.t = 0, 0.0
         self.t_const = fem.Constant(self.mesh, 0.0)
         self.output_fields = []

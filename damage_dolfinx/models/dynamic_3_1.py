@@ -41,7 +41,8 @@ from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model
 from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
 
@@ -72,7 +73,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
                                       "damage_active": True, "stability_check": "error",
                                       "error_norm": "velocity"})
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -156,7 +157,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
                                  bcs=self.bcs, normal=self.n_facet, k=self.k)
-        where = f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate"
+        where = f"{self.data.id}: explicit elastic and contact forces, eigenvalue estimate"
         checked(out, self.k, where, action)
         out["time_s"] = time.perf_counter() - start
         return out

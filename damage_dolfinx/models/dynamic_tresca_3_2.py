@@ -33,7 +33,8 @@ from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_form
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import checked, estimate_stability
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -41,7 +42,7 @@ from damage_dolfinx.parameters import ModelParameters
 class DynamicTresca(Model):
     """Problem VP^{hk} of Section 3.2.
 
-    Builders (ProblemData.builders): ``friction_bound`` (x -> UFL g(x), default the constant
+    Builders (Problem.builders): ``friction_bound`` (x -> UFL g(x), default the constant
     ``g_fric``) and ``contact_faces`` ({name: marker x -> bool}): for each face the history gets
     ``u_tau_max_<name>``, the largest |u_tau| over its contact nodes (nodal values).
     """
@@ -61,7 +62,7 @@ class DynamicTresca(Model):
                                extra={"rho": 1.0, "m_visc": 100.0, "g_fric": 5.0,
                                       "stability_check": "error", **FRICTION_DEFAULTS})
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data: Problem):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -94,7 +95,7 @@ class DynamicTresca(Model):
         self.friction_problem = FrictionProblem(self.v, a, l, self.bcs, g, ds(GAMMA_C),
                                                 self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.example_id)
+                                               data.id)
         self._faces_setup(data.builders.get("contact_faces") or {})
         self.k_max = self._stability_check(V, x)
 
@@ -134,7 +135,7 @@ class DynamicTresca(Model):
         p = self.params  # Tresca adds no explicit stiffness: c_nu = 0; eta_* Phi_L only lowers B
         out = estimate_stability(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
                                  bcs=self.bcs, k=self.k)
-        where = f"{self.data.example_id}: explicit elastic force, eigenvalue estimate"
+        where = f"{self.data.id}: explicit elastic force, eigenvalue estimate"
         checked(out, self.k, where, action)
         self.k_max_lower_bound = out.get("k_max_lower_bound")
         return None if out["k_max"] is None else float(out["k_max"])

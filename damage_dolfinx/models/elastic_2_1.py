@@ -34,7 +34,8 @@ from damage_dolfinx.numerics.solvers import LinearSolver, lagged_direct
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
-from damage_dolfinx.models.base import Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import Model
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -54,7 +55,7 @@ class ElasticDamage(Model):
                                variant="B", lam_D=0.1, lam_w=0.0, lam_u_plus=1000.0,
                                lam_u_minus=100.0, stop_at_zeta_star=True)
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh = self.params, self.mesh
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

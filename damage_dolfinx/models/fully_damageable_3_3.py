@@ -51,7 +51,8 @@ from damage_dolfinx.parameters import InputError, ModelParameters
 from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
 from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
 from damage_dolfinx.numerics.zeta_linear import VelocitySolver
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model
 
 #: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
 #: VELOCITY_EXTRAPOLATION);
@@ -89,7 +90,7 @@ class FullyDamageableContact(Model):
                                       "damage_active": True, "stability_check": "error",
                                       "elastic_term": "explicit"})
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -266,7 +267,7 @@ class FullyDamageableContact(Model):
                                  c_nu=self.c_nu if has_contact else 0.0, dsC=dsC, bcs=self.bcs,
                                  normal=self.n_facet, k=self.k)
         checked(out, self.k,
-                f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate",
+                f"{self.data.id}: explicit elastic and contact forces, eigenvalue estimate",
                 action=action if self.elastic_term == "explicit" else "off")
         out["time_s"] = time.perf_counter() - start
         return out

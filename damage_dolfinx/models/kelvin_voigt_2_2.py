@@ -31,7 +31,8 @@ from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -58,7 +59,7 @@ class KelvinVoigtTresca(Model):
         stable iff k m_visc zeta <= 2, so k_max = 2/m_visc (zeta <= 1)."""
         return 2.0 / float(params.extra["m_visc"])
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data: Problem):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -82,7 +83,7 @@ class KelvinVoigtTresca(Model):
         g = g_builder(ufl.SpatialCoordinate(msh)) if g_builder else fem.Constant(msh, x["g_fric"])
         self.friction_problem = FrictionProblem(self.v, a, l, bcs, g, ds(GAMMA_C), self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.example_id)
+                                               data.id)
         self._probe_setup(data.builders.get("probe"), ufl.action(a, self.v) - l)
 
         Q = compat.scalar_dg0(msh)

@@ -30,7 +30,8 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.numerics.cellwise_stress import StressUpdate
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -72,7 +73,7 @@ class ElastoViscoplasticFriction(Model):
             return params.replace(friction_law="coulomb" if "coulomb" in roles else "tresca")
         return params
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data: Problem):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z, Q = compat.vector_p1(msh), compat.scalar_p1(msh), compat.tensor_dg0(msh)
@@ -113,7 +114,7 @@ class ElastoViscoplasticFriction(Model):
         g = fem.Constant(msh, float(x["g_fric"] if law == "tresca" else x["mu_f"] * abs(x["S_n"])))
         self.friction_problem = FrictionProblem(self.w, a, l, bcs, g, ds(GAMMA_C), self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.example_id)
+                                               data.id)
 
         # (4) damage obstacle step, source from step n-1 (variant A, no sigma dependence:
         # docs/models.md, section 2.4)
