@@ -17,7 +17,6 @@ Convergence errors use the norm (3.109): ||u||_L2 + ||zeta||_L2.
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import ufl
@@ -34,7 +33,7 @@ from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import checked, estimate_stability
 from damage_dolfinx.problem import Problem
-from damage_dolfinx.models.base import DAMAGE_A, Model
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -54,7 +53,8 @@ class DynamicTresca(Model):
     stability_limit = "explicit elastic force (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face
-    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))
+    old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
+    update = ("u", "u_old", "v")  # (3.96) u_n = u_{n-1} + k v_n
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -108,18 +108,11 @@ class DynamicTresca(Model):
         self.timings = {"damage": 0.0, "friction": 0.0}
 
     # -- the scheme
-    def _advance(self) -> dict:
-        self.u_old.x.array[:] = self.u.x.array
-        self.v_old.x.array[:] = self.v.x.array
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        start = time.perf_counter()
-        damage_its = self.damage.solve()                                     # (3.94)
-        middle = time.perf_counter()
-        friction_its = self.friction.solve()                                 # (3.95) from v_{n-1}
-        self.timings["damage"] += middle - start
-        self.timings["friction"] += time.perf_counter() - middle
-        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array     # (3.96)
-        return {"damage_its": damage_its, "snes_its": friction_its, "friction_its": friction_its}
+    def scheme(self) -> tuple:
+        return (SubStep("damage", "snes-vi", "damage_", self.damage.solve,         # (3.94)
+                        its=("damage_its",)),
+                SubStep("friction", "newton", "friction_", self.friction.solve,    # (3.95)
+                        its=("snes_its", "friction_its")))
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
