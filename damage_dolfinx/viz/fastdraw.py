@@ -55,3 +55,12 @@ def inside_test(cells):
             out[i] = bool(np.any((s >= -tol) & (t >= -tol) & (s + t <= 1 + tol)))
         return out
     return inside
+
+
+def tight_bbox(fig):
+    """The bounding box that ``savefig(bbox_inches="tight")`` would compute (all the figure's
+    artists, padded by savefig.pad_inches), measured on the laid-out figure: handed to savefig
+    as ``bbox_inches``, it spares savefig a draw pass of its own to find it."""
+    import matplotlib
+    bbox = fig.get_tightbbox(fig.canvas.get_renderer())
+    return bbox.padded(matplotlib.rcParams["savefig.pad_inches"])
