@@ -196,9 +196,16 @@ class Example:
               configured=None):
         """Mesh, data and model of one run; ``configured``: what :meth:`configure` returned
         for the same arguments (None: configured here)."""
+        data = self.problem_data(comm, n, k, T, h, overrides, mesh_file, configured)
+        from damage_dolfinx.models.registry import model as model_info
+        return model_info(self._resolved(overrides)[0].model)(data)
+
+    def problem_data(self, comm, n=None, k=None, T=None, h=None, overrides=None,
+                     mesh_file=None, configured=None):
+        """Mesh and data of one run, checked against the mesh (no solver is set up)."""
         ex, overrides = self._resolved(overrides)
         if ex is not self:
-            return ex.build(comm, n, k, T, h, overrides, mesh_file, configured)
+            return ex.problem_data(comm, n, k, T, h, overrides, mesh_file, configured)
         params, time, n, h, mesh_file = configured or \
             self.configure(n, k, T, h, overrides, mesh_file, comm)
         from damage_dolfinx.meshes import read_mesh, retag
@@ -214,8 +221,7 @@ class Example:
                            self.zeta0, self.builders, self.damage_law, self.irreversible)
         from damage_dolfinx.validation import check_data
         check_data(data)  # loads, law, zeta0 against the mesh (validation.py)
-        from damage_dolfinx.models.registry import model as model_info
-        return model_info(self.model)(data)
+        return data
 
     def default_k(self, n, h, T, params) -> float:
         """The default time step at mesh (n, h) and final time T: the example's k, made smaller
