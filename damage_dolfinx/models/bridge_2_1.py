@@ -57,7 +57,7 @@ from damage_dolfinx.numerics.constitutive import eps
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.geometries import GAMMA_N
 from damage_dolfinx.parameters import InputError, ModelParameters
-from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.bridge_sections import RingSections
 from damage_dolfinx.models.elastic_2_1 import ElasticDamage
 
@@ -140,7 +140,7 @@ class BridgeDamage(RingSections, ElasticDamage):
         check_bridge_parameters(params.extra)
         return params
 
-    def __init__(self, data: ProblemData, **kwargs):
+    def __init__(self, data: Problem, **kwargs):
         geo = data.geometry
         if not hasattr(geo, "section_index"):
             raise InputError("example 2.1-ex3 needs the arch geometry (geometries/bridge.py); "
