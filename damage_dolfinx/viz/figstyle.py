@@ -321,7 +321,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     full = mathtext(title) + f" — {amplification_text(amplification)}{replaced}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight", **fastdraw.png_options(path))
+    fig.savefig(path, dpi=DPI, bbox_inches=_tight(fig), **fastdraw.png_options(path))
     pyplot.close(fig)
     return used
 
@@ -382,11 +382,15 @@ def legend_below(ax, ncol=3):
                   fontsize=8, frameon=False)
 
 
+def _tight(fig):
+    return fastdraw.tight_bbox(fig, plt().rcParams["savefig.pad_inches"])
+
+
 def save(fig, path, title=None):
     fig.tight_layout()
     if title:
         suptitle_on_top(fig, title)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight", **fastdraw.png_options(path))
+    fig.savefig(path, dpi=DPI, bbox_inches=_tight(fig), **fastdraw.png_options(path))
     plt().close(fig)
 
 
