@@ -397,7 +397,3 @@ class Model:
                 V = f.function_space
                 info[f"dofs_{name}"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
         return info
-
-
-#: the former name of :class:`Model`
-TimeStepper = Model
