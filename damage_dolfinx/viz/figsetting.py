@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import fastdraw
 from .figtext import mathtext
-from .figstyle import (LineCollection, _frame, boundary_edges, legend_below, trifinder,
+from .figstyle import (LineCollection, _frame, boundary_edges, legend_below,
                        triangle_edges)
 from .setting_geometry import spread, support_hatch, traction_arrows
 
@@ -14,10 +15,7 @@ LOAD_COLOURS = {"f_N": "tab:purple", "f_B": "tab:orange"}
 
 def inside_test(cells):
     """``inside(points) -> bool array``: points inside the body whose triangles are ``cells``."""
-    pts, inverse = np.unique(np.round(np.asarray(cells).reshape(-1, 2), 10), axis=0,
-                             return_inverse=True)
-    finder = trifinder(pts, inverse.reshape(-1, 3))
-    return lambda p: finder(np.asarray(p)[:, 0], np.asarray(p)[:, 1]) >= 0
+    return fastdraw.inside_test(cells)
 
 
 def body_force_points(cells, spacing):

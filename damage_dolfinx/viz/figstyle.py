@@ -24,8 +24,9 @@ import re
 
 import numpy as np
 
+from . import fastdraw
 from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks, range_decimals,  # noqa: F401
-                        is_damage, narrow_damage, shared_limits, si_unit)
+                        is_damage, narrow_damage, range_text, shared_limits, si_unit)
 from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
                       error_mathtext, is_round, mathtext, round_amplification)
 from .setting_geometry import (outward_normals, spread, support_hatch,  # noqa: F401
@@ -68,6 +69,7 @@ def triangle_edges(ax, xy, colour="k", linewidth=0.35, zorder=2):
     patch = PathPatch(triangle_path(xy), facecolor="none", edgecolor=colour,
                       linewidth=linewidth, zorder=zorder, joinstyle="miter", capstyle="butt")
     patch.set_rasterized(len(xy) > RASTERISE_CELLS)
+    fastdraw.out_of_layout(patch)
     ax.add_artist(patch)  # add_patch would walk the 10^5 segments for the data limits
     ax.update_datalim(np.asarray(xy, dtype=float).reshape(-1, 2))
     return patch
@@ -84,6 +86,7 @@ def draw_field(ax, tri, values, cmap, vmin, vmax):
     im = TriMesh(tri, array=per_vertex, cmap=cmap)
     im.set_clim(vmin, vmax)
     im.set_rasterized(len(per_vertex) // 3 > RASTERISE_CELLS)
+    fastdraw.out_of_layout(im)
     ax.grid(False)
     ax.update_datalim([(tri.x.min(), tri.y.min()), (tri.x.max(), tri.y.max())])
     ax.autoscale_view()
@@ -97,7 +100,8 @@ def plt():
     matplotlib.use("Agg")
     import matplotlib.pyplot as pyplot
     pyplot.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
-                            "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False})
+                            "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False,
+                            "figure.dpi": DPI})  # laid out as saved: text extents measured once
     return pyplot
 
 
@@ -109,7 +113,7 @@ def ticker():
 
 def save_as_laid_out(fig, path, dpi=300):
     """Save a figure whose layout and title its caller set (tight bounding box), and close it."""
-    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    fig.savefig(path, dpi=dpi, bbox_inches="tight", **fastdraw.png_options(path))
     plt().close(fig)
 
 
@@ -294,7 +298,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
                 if faint:  # the range of the field, on the fixed bar
                     cb.ax.axhspan(lo, hi, xmin=0, xmax=1, facecolor="none", edgecolor="red", lw=1.2)
                 ax.set_title(p.get("title", "damage $\\zeta$") + (f"\n{note}" if note else
-                             f"\n$\\zeta$ in [{lo:.3g}, {hi:.3g}]"),
+                             f"\n$\\zeta$ in {range_text(lo, hi)}"),
                              color="firebrick" if note else "k")
                 if faint:
                     stretched.append((ax, tri, vals, lo, hi))
@@ -317,7 +321,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     full = mathtext(title) + f" — {amplification_text(amplification)}{replaced}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    fig.savefig(path, dpi=DPI, bbox_inches=_tight(fig), **fastdraw.png_options(path))
     pyplot.close(fig)
     return used
 
@@ -330,7 +334,7 @@ def _stretched_damage(fig, ax, tri, vals, lo, hi):
     digits = range_decimals(lo, hi)
     cb.ax.yaxis.set_major_locator(MaxNLocator(4))
     cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.{digits}f}"))
-    ax.set_title(f"the same damage, colours stretched\nto its range [{lo:.3g}, {hi:.3g}]")
+    ax.set_title(f"the same damage, colours stretched\nto its range {range_text(lo, hi)}")
 
 
 #: colour map of the stretched damage panel: the damage's own (one colour map per field); its
@@ -341,8 +345,8 @@ STRETCHED_CMAP = DAMAGE_CMAP
 def suptitle_on_top(fig, text):
     """The figure title just above the axes' titles (equal-aspect axes shrink inside their
     slot; a default suptitle would float over an empty band)."""
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
+    renderer = fig.canvas.get_renderer()  # no draw first: get_tightbbox applies the aspect
+    # and updates the ticks itself (a full draw here doubled the text layout work)
     inv = fig.transFigure.inverted()
     top = max(ax.get_tightbbox(renderer).transformed(inv).y1 for ax in fig.axes)
     fig.suptitle(text, y=top + 0.01, va="bottom")
@@ -367,12 +371,6 @@ def LineCollection(segments, **kwargs):
     return collection(segments, **kwargs)
 
 
-def trifinder(points, triangles):
-    """``finder(x, y)``: the index of the triangle holding each point (-1 outside)."""
-    import matplotlib.tri as mtri
-    return mtri.Triangulation(points[:, 0], points[:, 1], triangles).get_trifinder()
-
-
 def legend_below(ax, ncol=3):
     """Legend under the axes' x label (never over the mesh), at a fixed distance in points
     whatever the axes' height."""
@@ -384,11 +382,15 @@ def legend_below(ax, ncol=3):
                   fontsize=8, frameon=False)
 
 
+def _tight(fig):
+    return fastdraw.tight_bbox(fig, plt().rcParams["savefig.pad_inches"])
+
+
 def save(fig, path, title=None):
     fig.tight_layout()
     if title:
         suptitle_on_top(fig, title)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    fig.savefig(path, dpi=DPI, bbox_inches=_tight(fig), **fastdraw.png_options(path))
     plt().close(fig)
 
 
