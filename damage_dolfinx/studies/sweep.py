@@ -48,7 +48,7 @@ from mpi4py import MPI
 
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
-                                                 SWEEP_FILES, claim_sweep_folder, plot_sweep)
+                                                 SWEEP_FILES, plot_sweep)
 from damage_dolfinx.studies.sweep_folder import describe_values as _describe
 
 
@@ -194,7 +194,8 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                "shared": _shared(ex, grid)}
     out = io.prepare_output_dir(out, comm)
     states = open_sweep(out, mapping, point, comm)
-    track(out, "sweep")
+    if point is None:  # a job of one point leaves the sweep's status to the record (others run)
+        track(out, "sweep")
 
     if point is not None:
         pending = [] if states[point] == "completed" else [point]
@@ -228,7 +229,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
             start = time.perf_counter()
             try:
                 summary = _point_outcome(
-                    group, comm, [(folder, "run"), (out, "sweep")],
+                    group, comm, [(folder, "run")] + ([(out, "sweep")] if point is None else []),
                     lambda: run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
                                     progress=False, figures=figures, restart=resume,
                                     overwrite=not resume, comm=group))
