@@ -220,7 +220,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                 f"{size} rank(s)"
             print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
                   f"running {len(todo)} on {layout}", flush=True)
-    failures, elsewhere = {}, []
+    failures = {}
     try:
         for i in mine:
             values = points[i]
@@ -234,12 +234,10 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                                     progress=False, figures=figures, restart=resume,
                                     overwrite=not resume, comm=group))
                 status = summary["status"]
-            except RunLive as exc:
+            except RunLive:
                 if point is not None:
                     raise  # the one point asked for is live elsewhere: refused
-                status = "left to the process running it"
-                elsewhere.append(i)
-                del exc
+                status = "live in another process, left to it"
             except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
                 if classify(exc)[2] == "interrupted":
                     raise  # the sweep stops (collective.outcome decides for every rank)
