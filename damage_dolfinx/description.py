@@ -210,11 +210,10 @@ def configure(ex: Problem, n=None, k=None, T=None, h=None, overrides=None, mesh_
     return dataclasses.replace(ex, params=params, T=T, k=k, _checked=True, **sized)
 
 
-def build(c: Problem, comm):
-    """The model of the configured problem ``c`` on ``comm``: its mesh (the problem's own, or
-    the mesh file replacing it, with the example's tags required) with the boundary roles named,
-    checked against the loads, law and initial damage, then the model built from the problem on
-    that mesh."""
+def on_mesh(c: Problem, comm) -> Problem:
+    """The configured problem ``c`` on its mesh on ``comm`` (the problem's own, or the mesh file
+    replacing it, with the example's tags required), the boundary roles named, checked against
+    the loads, law and initial damage: what a model is built from (no solver set up)."""
     from damage_dolfinx.meshes import read_mesh, retag
     from damage_dolfinx.models.registry import model
     from damage_dolfinx.validation import check_data
@@ -224,7 +223,12 @@ def build(c: Problem, comm):
     else:
         geometry = c.make_geometry(comm, c.n, c.h)
         required = None
-    info = model(c.model)
-    built = dataclasses.replace(c, mesh=retag(geometry, c.boundaries, required, info))
+    built = dataclasses.replace(c, mesh=retag(geometry, c.boundaries, required, model(c.model)))
     check_data(built)  # loads, law, zeta0 against the mesh (validation.py)
-    return info(built)
+    return built
+
+
+def build(c: Problem, comm):
+    """The model of the configured problem ``c`` on ``comm``, built on :func:`on_mesh`."""
+    from damage_dolfinx.models.registry import model
+    return model(c.model)(on_mesh(c, comm))

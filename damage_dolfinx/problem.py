@@ -262,6 +262,13 @@ class Problem:
         from damage_dolfinx.description import build
         return build(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
 
+    def problem_data(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+                     configured=None) -> "Problem":
+        """The configured problem on its mesh on ``comm``, checked: what a model is built from
+        (no solver set up; the run fingerprint reads it)."""
+        from damage_dolfinx.description import on_mesh
+        return on_mesh(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
+
     def mesh_requirements(self):
         """(dimension, facet tags) a --mesh file must have (a catalogue example's)."""
         raise InputError(f"{self.name}: a problem of your own takes its mesh as Problem(mesh=...)")

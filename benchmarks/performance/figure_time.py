@@ -1,7 +1,7 @@
 """Wall time of each figure of a run, drawn in-process on the state after a few steps (the
 drawing cost depends on the mesh, not on the time reached):
 
-    python benchmarks/performance/figure_time.py 3.1-ex1 --n 128 [--steps 2] [--repeat 3]
+    python benchmarks/performance/figure_time.py 3.1-ex1 --n 128 [--steps 2] [--repeat 3] [--out DIR]
 
 Runs `damage-dolfinx run ID --n N --T steps*k` once with figures on, timing every call that
 draws a figure and the first import of matplotlib, then draws each figure again ``repeat``
@@ -24,6 +24,7 @@ def main():
     ap.add_argument("--n", type=int, required=True)
     ap.add_argument("--steps", type=int, default=2)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--out", default=None, help="run folder (kept; default: a temporary one)")
     args = ap.parse_args()
     k = examples.get(args.example).k
     times, calls = {}, []
@@ -40,7 +41,7 @@ def main():
     from damage_dolfinx.viz import figstyle
     figstyle.plt()  # matplotlib's import, apart from the drawing
     mpl_import = time.perf_counter() - start
-    out = tempfile.mkdtemp()
+    out = args.out or tempfile.mkdtemp()
     sys.argv = ["damage-dolfinx", "run", args.example, "--n", str(args.n),
                 "--T", f"{args.steps * k:.12g}", "--quiet", "--overwrite", "--out", out]
     try:

@@ -56,7 +56,7 @@ def main(argv=None):
 
 def _main(argv, comm, given):
     from damage_dolfinx.runtime import collective
-    from damage_dolfinx.runtime.io import OutputError
+    from damage_dolfinx.runtime.atomic import OutputError  # (runtime.io would load dolfinx)
     from damage_dolfinx.runtime.signals import RunInterrupted
     try:
         with collective.outcome(comm):

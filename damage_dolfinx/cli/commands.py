@@ -21,8 +21,9 @@ def command(argv, comm, given):
     _check_petsc_values(given)
     _load_plugins()
     if args.command != "list":
-        from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
-        import_gmsh_keeping_sigint()
+        from damage_dolfinx.runtime.signals import keeping_sigint
+        with keeping_sigint():  # gmsh itself only where a mesh needs it (geometries)
+            import dolfinx.io  # noqa: F401
     from damage_dolfinx.catalogue import examples  # the catalogue's ids (runtime/cases.py)
     if args.command == "list":
         if comm.rank == 0:

@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-import numpy as np
 from mpi4py import MPI
 
 
@@ -106,6 +105,7 @@ def _unused(given, comm):
     used = [compat.petsc_option_used(n) for n in names]
     if any(u is None for u in used):
         return []
+    import numpy as np  # (not at the top: --help loads no numpy)
     used = comm.allreduce(np.array(used, dtype=np.int32), op=MPI.MAX) if names else []
     return [f"-{n}" for n, u in zip(names, used) if not u]
 
@@ -113,6 +113,8 @@ def _unused(given, comm):
 def _forget(given):
     """Remove the options of this command, and the solvers' defaults, from the PETSc database
     (a later command in the same process, e.g. the tests, starts clean)."""
+    if "petsc4py.PETSc" not in sys.modules:  # nothing was set (--help: no PETSc loaded)
+        return
     from petsc4py import PETSc
     opts = PETSc.Options()
     for name in given:

@@ -324,14 +324,16 @@ class Model:
         if not hasattr(self, "_norm_operators"):
             self._norm_operators = self._assemble_norm_operators()
         M, K, m, area, y = self._norm_operators
-        u = compat.petsc_vec(self.u)
+        u, dot = compat.petsc_vec(self.u), bookkeeping.local_dot  # this rank's part
         M.mult(u, y)
-        u_L2_sq = u.dot(y)
+        parts = [dot(u, y)]
         K.mult(u, y)
-        eps_sq = u.dot(y)
-        zeta_integral = m.dot(compat.petsc_vec(self.zeta))
+        parts += [dot(u, y), dot(m, compat.petsc_vec(self.zeta))]
         owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
-        (zeta_min,), (zeta_max,) = bookkeeping.extrema(self.comm, [owned], [owned])
+        lo, hi = (owned.min(), owned.max()) if owned.size else (np.inf, -np.inf)
+        (u_L2_sq, eps_sq, zeta_integral), (neg_min, zeta_max) = \
+            bookkeeping.sums_and_maxima(self.comm, parts, [-lo, hi])  # one reduction
+        zeta_min = -neg_min
         return {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
                 "zeta_min": zeta_min, "zeta_max": zeta_max,
                 "zeta_mean": float(zeta_integral / area)}
@@ -395,7 +397,3 @@ class Model:
                 V = f.function_space
                 info[f"dofs_{name}"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
         return info
-
-
-#: the former name of :class:`Model`
-TimeStepper = Model

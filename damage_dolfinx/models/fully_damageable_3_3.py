@@ -288,7 +288,7 @@ class FullyDamageableContact(Model):
 
     # -- scalars and summary
     def scalars(self) -> dict:
-        """The base scalars (the same operations as TimeStepper.scalars, so the same values)
+        """The base scalars (the same operations as Model.scalars, so the same values)
         plus v_L2, the interpenetration and the probe. The runner asks for them after every
         step (history.csv), so the vectors and views are cached and the extrema take one
         Allreduce, none in serial (120 -> 40 us per wrench step)."""

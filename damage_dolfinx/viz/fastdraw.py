@@ -55,3 +55,11 @@ def inside_test(cells):
             out[i] = bool(np.any((s >= -tol) & (t >= -tol) & (s + t <= 1 + tol)))
         return out
     return inside
+
+
+def tight_bbox(fig, pad_inches):
+    """The bounding box that ``savefig(bbox_inches="tight")`` would compute (all the figure's
+    artists, padded by ``pad_inches``: rcParams["savefig.pad_inches"]), measured on the
+    laid-out figure: handed to savefig as ``bbox_inches``, it spares savefig a draw pass of its
+    own to find it."""
+    return fig.get_tightbbox(fig.canvas.get_renderer()).padded(pad_inches)
