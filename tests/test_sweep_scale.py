@@ -218,3 +218,12 @@ def test_a_failure_on_one_rank_of_a_group_ends_the_whole_sweep(tmp_path):
     for folder in out.glob("point_*"):
         if (folder / "summary.json").exists():
             assert json.loads((folder / "summary.json").read_text())["status"] != "running"
+
+
+def test_a_refused_folder_receives_no_lock_file(tmp_path):
+    out = tmp_path / "notes"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")
+    r = cli(*TINY, "--point", 0, "--out", out)
+    assert r.returncode == 2 and "notes.txt" in r.stderr, r.stderr
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

@@ -44,8 +44,9 @@ def main():
     whole = {n: stamps[n] - stamps[n - 1] for n in range(args.warmup + 1, N)}
     w = statistics.median(whole.values())
     b = w - statistics.median(rows[n] for n in steps)
-    print(f"{args.example} n = {args.n}, history every {args.history_every}: step {w * 1e3:.2f} ms, "
-          f"solve {statistics.median(rows[n] for n in steps) * 1e3:.2f} ms, bookkeeping "
+    print(f"{args.example} n = {args.n}, history every {args.history_every}: "
+          f"step {w * 1e3:.2f} ms, solve {statistics.median(rows[n] for n in steps) * 1e3:.2f} "
+          f"ms, bookkeeping "
           f"{b * 1e3:.2f} ms ({100 * b / w:.1f} %) (median of {len(steps)} steps)")
 
 

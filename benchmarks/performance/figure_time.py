@@ -1,7 +1,8 @@
 """Wall time of each figure of a run, drawn in-process on the state after a few steps (the
 drawing cost depends on the mesh, not on the time reached):
 
-    python benchmarks/performance/figure_time.py 3.1-ex1 --n 128 [--steps 2] [--repeat 3] [--out DIR]
+    python benchmarks/performance/figure_time.py 3.1-ex1 --n 128 [--steps 2] [--repeat 3]
+        [--out DIR]
 
 Runs `damage-dolfinx run ID --n N --T steps*k` once with figures on, timing every call that
 draws a figure and the first import of matplotlib, then draws each figure again ``repeat``

@@ -28,6 +28,11 @@ with the consistent mass matrix it leaves checkerboard oscillations in the damag
 "none" is the literal linear step (2.20). The damage figures are drawn on [zeta_star, 1]
 (figstyle; a field that leaves it widens the scale and prints its extremes).
 
+The step is 2.1's, the package's generic one (models/base.py), with the damage sub-step of
+``damage_bound``; the failure record (the first failed section, the hinges, the running minimum
+of zeta) is kept after each step by ``scalars`` and ``stop_reason``, not inside the step, and is
+not checkpointed (``checkpoint_supported`` is False).
+
 Hinges and the mechanism: bridge_sections.py (section damage D_j, its peaks, the rotation of
 each cross-section and which hinges move at collapse).
 

@@ -113,11 +113,10 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
                                    const(self.gap), self.n_facet, f_B, f_N, ds(GAMMA_N),
                                    ds(GAMMA_C) if self.has_contact else None)
         self.bcs = [clamped(V, tags, GAMMA_D)]
-        amg = msh.topology.dim == 3 and scalable.global_dofs(V) >= VELOCITY_DIRECT_MAX_DOFS_3D
         self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context, constant_matrix=True,
-                                 defaults=scalable.MECH_AMG if amg else
-                                 serial_cholesky(msh.comm, DIRECT))
-        scalable.prepare_mech(self.mech, V)  # 3-D: near-nullspace, warm start; 2-D: nothing
+                                 defaults=scalable.constant_config(
+                                     V, serial_cholesky(msh.comm, DIRECT), mech_prefix))
+        scalable.prepare_mech(self.mech, V)  # near-nullspace; with AMG: warm start
         self.stability = self._stability_check(V, x, ds(GAMMA_C))
 
         # output: von Mises of the total stress and of the strain, DG0 (docs/models.md, "Output

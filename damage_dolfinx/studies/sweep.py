@@ -48,7 +48,7 @@ from mpi4py import MPI
 
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
-                                                 SWEEP_FILES, claim_sweep_folder, plot_sweep)
+                                                 SWEEP_FILES, plot_sweep)
 from damage_dolfinx.studies.sweep_folder import describe_values as _describe
 
 
@@ -194,7 +194,8 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                "shared": _shared(ex, grid)}
     out = io.prepare_output_dir(out, comm)
     states = open_sweep(out, mapping, point, comm)
-    track(out, "sweep")
+    if point is None:  # a job of one point leaves the sweep's status to the record (others run)
+        track(out, "sweep")
 
     if point is not None:
         pending = [] if states[point] == "completed" else [point]
@@ -219,7 +220,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                 f"{size} rank(s)"
             print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
                   f"running {len(todo)} on {layout}", flush=True)
-    failures, elsewhere = {}, []
+    failures = {}
     try:
         for i in mine:
             values = points[i]
@@ -228,17 +229,15 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
             start = time.perf_counter()
             try:
                 summary = _point_outcome(
-                    group, comm, [(folder, "run"), (out, "sweep")],
+                    group, comm, [(folder, "run")] + ([(out, "sweep")] if point is None else []),
                     lambda: run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
                                     progress=False, figures=figures, restart=resume,
                                     overwrite=not resume, comm=group))
                 status = summary["status"]
-            except RunLive as exc:
+            except RunLive:
                 if point is not None:
                     raise  # the one point asked for is live elsewhere: refused
-                status = "left to the process running it"
-                elsewhere.append(i)
-                del exc
+                status = "live in another process, left to it"
             except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
                 if classify(exc)[2] == "interrupted":
                     raise  # the sweep stops (collective.outcome decides for every rank)
@@ -271,9 +270,9 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
 
 def _point_outcome(group, comm, folders, body):
     """``body()`` on every rank of ``group`` (the ranks running one point), with one outcome on
-    all of them: its value, or the same exception everywhere (a failing rank's own, the others a
-    collective.RankFailure carrying its line). A rank that failed while its partners do not
-    join within collective.FAIL_WAIT seconds (they are blocked in a collective call it left)
+    all of them: its value, or the same exception everywhere (a failing rank's own, the others
+    a collective.RankFailure of the same kind carrying its line). A rank that failed while its
+    partners do not join within collective.FAIL_WAIT seconds (they are blocked in a collective call it left)
     ends the whole sweep: ``folders`` get the status, one line, MPI_Abort with its exit status
     (collective.py's rule, here within one group while the sweep's other groups go on)."""
     if group.size == 1:
@@ -301,7 +300,7 @@ def _point_outcome(group, comm, folders, body):
     if failure is not None:
         raise failure
     _, code, kind, text = failed[0]
-    raise collective.RankFailure(text, code, kind)
+    raise collective.decided(text, code, kind)
 
 
 class _Relay:

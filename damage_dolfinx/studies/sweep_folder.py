@@ -60,18 +60,14 @@ def open_sweep(out, mapping, point, comm) -> list:
     (``point_state``); ``point`` (an index): only that point's folder is checked (the others
     may be written by other jobs at this moment)."""
     from damage_dolfinx.runtime import runfolder
+    # the checks first without the lock, so that a refused folder does not receive a lock file;
+    # then again under it (another process may have written the folder in between)
+    runfolder.decided(comm, out, _open, Path(out), mapping, point, False)
     with runfolder.shared_folder_lock(out, comm):
-        return runfolder.decided(comm, out, _open, Path(out), mapping, point)
+        return runfolder.decided(comm, out, _open, Path(out), mapping, point, True)
 
 
-def claim_sweep_folder(out, count, restart, comm) -> list:
-    """The folder rules of a sweep of ``count`` points alone (no points.json written): see
-    :func:`open_sweep`."""
-    from damage_dolfinx.runtime import runfolder
-    return runfolder.decided(comm, out, _claim_sweep, Path(out), count, None)
-
-
-def _open(out: Path, mapping: dict, point) -> list:
+def _open(out: Path, mapping: dict, point, apply: bool) -> list:
     from damage_dolfinx.runtime.atomic import write_json
     existing = None
     if (out / "points.json").is_file():
@@ -89,7 +85,9 @@ def _open(out: Path, mapping: dict, point) -> list:
             {key: wanted[key] for key in keys}:
         raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
                          "T in its points.json); choose another out folder")
-    states = _claim_sweep(out, len(mapping["points"]), point)
+    states = _claim_sweep(out, len(mapping["points"]), point, apply)
+    if not apply:
+        return states
     if existing is None:
         write_json(out / "points.json", mapping, MPI.COMM_SELF)
     summary = _read_summary(out)
@@ -107,7 +105,7 @@ def _read_summary(out: Path) -> dict:
     return summary if isinstance(summary, dict) and summary.get("schema") == SCHEMA else {}
 
 
-def _claim_sweep(out: Path, count: int, point) -> list:
+def _claim_sweep(out: Path, count: int, point, apply=True) -> list:
     from damage_dolfinx.runtime import runfolder
     names = {f"point_{i}" for i in range(count)} | set(SWEEP_FILES)
     present = {p.name for p in out.iterdir()}
@@ -151,7 +149,8 @@ def _claim_sweep(out: Path, count: int, point) -> list:
                 raise InputError(f"{str(folder)!r} holds a convergence study: choose another "
                                  "--out (nothing was touched)")
         states.append(point_state(folder))
-    runfolder.write_manifest(out, "sweep", names | (ours & present))
+    if apply:
+        runfolder.write_manifest(out, "sweep", names | (ours & present))
     return states
 
 
