@@ -52,7 +52,7 @@ SCRIPT = textwrap.dedent('''
                          params={"E": 2000.0, "g_fric": 10.0})
     if what == "fingerprint":
         from damage_dolfinx.runtime import checkpoint
-        ex = problem.example()
+        ex = problem.checked()
         fp = checkpoint.fingerprint(ex, ex.problem_data(MPI.COMM_WORLD, n=3))
         if MPI.COMM_WORLD.rank == 0:
             print(json.dumps(fp, sort_keys=True))

@@ -1,15 +1,20 @@
-"""Solver defaults by dimension and size: iterative solvers whose cost grows about
-linearly with the mesh, for 3-D.
+"""Solver defaults by dimension and size: below a size, direct factorisations; above it,
+iterative solvers whose cost grows about linearly with the mesh.
 
-2-D keeps the package's direct defaults unchanged (they serve the thesis meshes well). In 3-D:
+The rule lives in one function, :func:`iterative`: a system is solved by CG + algebraic
+multigrid when the global number of unknowns of its space is at least ``AMG_MIN_DOFS[dim]``
+(measured crossovers, docs/solvers.md; overridable per solver by ``-<prefix>amg_min_dofs N``).
+Below that size the package's direct defaults are kept unchanged (they serve the thesis meshes
+well). Above it:
 
-* elasticity: CG + algebraic multigrid (PETSc GAMG) with the rigid-body near-nullspace (6 modes:
-  3 translations, 3 rotations), the AMG hierarchy of an earlier step's matrix reused while CG
-  needs at most ``MECH_AMG_REBUILD_ITS`` iterations (the lagged scheme of ``LinearSolver``);
-* damage (M + k kappa K, SPD, constant for a fixed k): CG + AMG, set up once (hypre BoomerAMG
-  where PETSc has it, else GAMG);
-* very small 3-D systems (below ``DIRECT_MAX_DOFS_3D`` dofs) keep the direct defaults: there a
-  factorisation costs less than an AMG setup.
+* elasticity (2.1 (2.21), its 3-D extension) and the velocity step of 3.1 (3.48): CG +
+  smoothed-aggregation AMG (PETSc GAMG) with the rigid-body near-nullspace (3 modes in 2-D:
+  2 translations, 1 rotation; 6 in 3-D), CG started from the previous step's solution. A
+  constant matrix (3.1) is set up once; a matrix that changes every step (2.1, with zeta_n)
+  keeps the AMG hierarchy of an earlier step while CG needs at most ``MECH_AMG_REBUILD_ITS``
+  iterations (the lagged scheme of ``LinearSolver``);
+* the damage PDE step (M + k kappa K, SPD, constant for a fixed k): CG + AMG, set up once
+  (hypre BoomerAMG where PETSc has it, else GAMG).
 
 Every choice is a code default under the solver's options prefix, so ``-mech_pc_type hypre``,
 ``-damage_pc_type jacobi`` or ``-mech_ksp_type preonly -mech_pc_type lu`` on the command line win.
@@ -19,10 +24,15 @@ from __future__ import annotations
 import numpy as np
 from petsc4py import PETSc
 
-#: below this many unknowns a 3-D system is factorised (direct defaults of the 2-D package)
-DIRECT_MAX_DOFS_3D = 3000
+#: the smallest system (global unknowns of its function space) solved by CG + AMG, by
+#: dimension of the mesh; smaller systems are factorised (docs/solvers.md: how they were chosen)
+AMG_MIN_DOFS = {2: 10 ** 9, 3: 3000}
+#: the 3-D threshold under its former name
+DIRECT_MAX_DOFS_3D = AMG_MIN_DOFS[3]
 #: CG iterations above which the reused elasticity AMG hierarchy is rebuilt
 MECH_AMG_REBUILD_ITS = 40
+#: the PETSc option (after the solver's prefix) that replaces AMG_MIN_DOFS for that solver
+MIN_DOFS_OPTION = "amg_min_dofs"
 
 
 def has_hypre() -> bool:
@@ -65,31 +75,59 @@ def global_dofs(V) -> int:
     return imap.size_global * V.dofmap.index_map_bs
 
 
-def iterative(V) -> bool:
-    """The rule: AMG for 3-D meshes with at least DIRECT_MAX_DOFS_3D unknowns in V."""
-    return V.mesh.topology.dim == 3 and global_dofs(V) >= DIRECT_MAX_DOFS_3D
+def amg_min_dofs(dim: int, prefix: str = "") -> int:
+    """The threshold of :func:`iterative` for a solver with options prefix ``prefix``:
+    ``-<prefix>amg_min_dofs N`` where given, else ``AMG_MIN_DOFS[dim]``. A value that is no
+    whole number >= 0 is an InputError."""
+    name = prefix + MIN_DOFS_OPTION
+    opts = PETSc.Options()
+    if not prefix or not opts.hasName(name):
+        return AMG_MIN_DOFS[dim]
+    raw = opts.getString(name, "")  # read: PETSc counts the option as used
+    try:
+        value = float(raw)
+    except ValueError:
+        value = float("nan")
+    if not (value >= 0 and value == int(value)):
+        from damage_dolfinx.parameters import InputError
+        raise InputError(f"-{name} must be a whole number of unknowns >= 0, got {raw!r}")
+    return int(value)
 
 
-def mech_config(V, direct_defaults, direct_refactor_its):
+def iterative(V, prefix: str = "") -> bool:
+    """The rule: CG + AMG for a system on V when V has at least ``amg_min_dofs`` global
+    unknowns for its mesh's dimension (and the solver's ``-<prefix>amg_min_dofs``)."""
+    dim = V.mesh.topology.dim
+    return global_dofs(V) >= amg_min_dofs(dim, prefix)
+
+
+def mech_config(V, direct_defaults, direct_refactor_its, prefix: str = "mech_"):
     """(defaults, refactor_after_its) of an elasticity LinearSolver on V."""
-    if iterative(V):
+    if iterative(V, prefix):
         return MECH_AMG, MECH_AMG_REBUILD_ITS
     return direct_defaults, direct_refactor_its
 
 
-def damage_config(Z):
+def constant_config(V, direct_defaults, prefix: str = "mech_"):
+    """KSP defaults of an elasticity-like system with a constant matrix on V (3.1's velocity):
+    CG + GAMG on the rigid-body modes, set up once, above the size of :func:`iterative`."""
+    return MECH_AMG if iterative(V, prefix) else direct_defaults
+
+
+def damage_config(Z, prefix: str = "damage_"):
     """KSP defaults of the damage PDE step on Z (None: the package's direct default)."""
-    return damage_amg() if iterative(Z) else None
+    return damage_amg() if iterative(Z, prefix) else None
 
 
 def prepare_mech(solver, V):
-    """In 3-D: give the elasticity matrix its rigid-body near-nullspace (used by GAMG, also
-    when the user picks it by options) and, for a Krylov solve, start from the previous step's
-    displacement. Nothing in 2-D."""
-    if V.mesh.topology.dim != 3:
-        return
+    """Give the elasticity matrix its rigid-body near-nullspace (used by GAMG, also when the
+    user picks it by options; a factorisation ignores it) and, for a Krylov solve on AMG, start
+    from the previous step's solution. The 2-D direct defaults are left exactly as they are
+    (their CG on a lagged factorisation starts from zero)."""
     solver.A.setNearNullSpace(rigid_body_modes(V))
-    if solver.ksp.getType() != "preonly":
+    pc_type = solver.ksp.getPC().getType()
+    if solver.ksp.getType() != "preonly" and (V.mesh.topology.dim == 3 or
+                                              pc_type not in ("lu", "cholesky")):
         solver.ksp.setInitialGuessNonzero(True)
 
 
