@@ -88,7 +88,8 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     The folder follows the rules of a run (runfolder.claim_folder, manifest.json): a folder
     holding a run is refused, one holding a study unless ``overwrite`` (its listed files are
     replaced) or ``restart`` (nothing to do when it completed with these settings; studies keep
-    no checkpoints, so an unfinished one runs again). A solver failure or a non-finite error
+    no checkpoints, so an unfinished one runs again; settings or a run fingerprint of any level
+    that differ are refused, naming them: convergence_resume.py). A solver failure or a non-finite error
     leaves summary.json with status "failed" and the error."""
     wall_start = time.perf_counter()
     from damage_dolfinx.runtime.runner import resolve
