@@ -366,10 +366,12 @@ def check_run(n=None, k=None, T=None, restart=False, overwrite=False, checkpoint
                 progress=flag("progress", progress), figures=flag("figures", figures))
 
 
-def check_converge(n, k, ref_n, ref_k, T):
-    """The levels of converge(): lists of whole n and positive k, the reference's, T."""
+def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True):
+    """The levels of converge(): lists of whole n and positive k, the reference's, T, and its
+    two flags."""
     return (levels("n", n, whole), levels("k", k, positive), whole("ref_n", ref_n),
-            positive("ref_k", ref_k), positive("T", T, allow_none=True))
+            positive("ref_k", ref_k), positive("T", T, allow_none=True),
+            flag("restart", restart), flag("overwrite", overwrite))
 
 
 def check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress):

@@ -81,8 +81,8 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
                        progress=progress, figures=figures, comm=comm).steps()
 
 
-def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
-             comm=MPI.COMM_WORLD) -> dict:
+def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart=False,
+             overwrite=True, comm=MPI.COMM_WORLD) -> dict:
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
     run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
     and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
@@ -93,14 +93,19 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True,
     point evaluation of the coarse fields at the reference mesh's nodes (P1) and cell midpoints
     (DG0); a family whose meshes do not cover the same domain is refused before any step.
     The summary states the norm (``norm``, ``error_definition``) and the comparison
-    (``comparison``). ``progress=False`` prints nothing."""
+    (``comparison``). ``progress=False`` prints nothing. ``restart=True`` on a folder
+    holding a study: nothing to do when it completed with these settings, else it runs again
+    (studies keep no checkpoints); a study whose settings or run fingerprint at any level (mesh,
+    loads, law, ... as a run's restart checks) differ is refused, naming what changed.
+    ``overwrite=False`` refuses a folder that holds a study."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
     from damage_dolfinx.validation import check_converge
     with outcome(comm):
-        n, k, ref_n, ref_k, T = check_converge(n, k, ref_n, ref_k, T)
+        n, k, ref_n, ref_k, T, restart, overwrite = check_converge(n, k, ref_n, ref_k, T,
+                                                                   restart, overwrite)
         return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
-                     progress=progress, comm=comm)
+                     progress=progress, comm=comm, restart=restart, overwrite=overwrite)
 
 
 def gather(function):

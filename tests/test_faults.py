@@ -38,7 +38,9 @@ def _max_diff(a, b):
     return max(rel_diff(fa[k], fb[k]) for k in fb if not k.endswith("_coords"))
 
 
-def _wait_for_step(out, step, proc, timeout=120):
+def _wait_for_step(out, step, proc, timeout=900):
+    """Until history.csv has reached ``step`` (returns at once then; a loaded machine only
+    makes it wait longer), the process ended, or ``timeout`` s."""
     deadline = time.time() + timeout
     while time.time() < deadline and proc.poll() is None:
         rows = io.CSVHistory.read_rows(out / "history.csv", 10 ** 9)
@@ -205,7 +207,7 @@ def test_output_folder_deleted_mid_run(tmp_path, np_):
     _wait_for_step(out, 20, proc)
     while out.exists():  # files may appear while the tree is removed
         shutil.rmtree(out, ignore_errors=True)
-    _, err = proc.communicate(timeout=120)
+    _, err = proc.communicate(timeout=900)  # the next write fails: seconds, more when loaded
     assert proc.returncode == 4, err
     ours = [line for line in err.splitlines() if line.startswith("damage-dolfinx:")]
     assert len(ours) == 1 and "Traceback" not in err, err
@@ -307,3 +309,140 @@ def test_xdmf_killed_mid_write_is_restored_from_its_copy(tmp_path):
     assert io.repair_xdmf(tmp_path) == ["fields.xdmf"]
     assert (tmp_path / "fields.xdmf").read_text() == good
     assert not list(tmp_path.glob("*.bak"))
+
+
+# ---------------------------------------------------------------------------- a full disk
+@pytest.fixture
+def small_disk(tmp_path):
+    """A 64 MB tmpfs (root only: skipped elsewhere) whose space ``fill()`` takes, at the moment
+    a test chooses, until a write fails with ENOSPC; ``free()`` gives it back."""
+    mount = tmp_path / "disk"
+    mount.mkdir()
+    proc = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64m", "tmpfs", str(mount)],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        pytest.skip(f"no tmpfs mount here: {proc.stderr.strip()}")
+
+    class Disk:
+        path = mount
+        filler = mount / "filler"
+
+        def fill(self):
+            block = b"\0" * (1 << 16)
+            with open(self.filler, "ab") as f:
+                try:
+                    while True:
+                        f.write(block)
+                        f.flush()
+                except OSError as exc:
+                    assert exc.errno == errno.ENOSPC
+            try:  # the last bytes too (a tmpfs counts pages)
+                with open(self.filler.with_suffix(".tail"), "ab") as f:
+                    while True:
+                        f.write(b"\0")
+                        f.flush()
+            except OSError:
+                pass
+
+        def free(self):
+            for f in (self.filler, self.filler.with_suffix(".tail")):
+                f.unlink(missing_ok=True)
+    try:
+        yield Disk()
+    finally:
+        subprocess.run(["umount", "-l", str(mount)], capture_output=True)
+
+
+def _full_then(disk, real):
+    """``real``, called when the disk has just become full."""
+    def call(*args, **kwargs):
+        disk.fill()
+        return real(*args, **kwargs)
+    return call
+
+
+def _one_line(err, start):
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and "Traceback" not in err, err
+    assert lines[0].startswith(start), lines[0]
+    return lines[0]
+
+
+CONVERGE = ["converge", "2.1-ex1", "--ref-n", "20", "--n", "5", "10", "--ref-k", "0.01", "--k",
+            "0.02", "--T", "0.04", "--quiet"]
+
+
+def test_full_disk_at_the_convergence_plot(small_disk, capsys, monkeypatch):
+    """The disk fills while converge draws convergence.png: exit status 4, one line naming the
+    file, summary.json 'failed' (the lock's reserve takes it); the space freed, --restart runs
+    the study again and completes."""
+    from damage_dolfinx.studies import convergence
+    out = small_disk.path / "study"
+    with monkeypatch.context() as patch:
+        patch.setattr(convergence, "plot_convergence",
+                      _full_then(small_disk, convergence.plot_convergence))
+        status, _, err = _main(CONVERGE, out, capsys)
+    assert status == 4, err
+    line = _one_line(err, "damage-dolfinx: output error: cannot write ")
+    assert "convergence.png" in line and "No space left on device" in line, line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and "convergence.png" in summary["error"]
+    small_disk.free()
+    status, _, err = _main(CONVERGE + ["--restart"], out, capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "completed" and len(summary["errors"]) == 2
+    assert (out / "convergence.png").stat().st_size > 0
+
+
+def test_full_disk_at_a_runs_figures(small_disk, capsys, monkeypatch):
+    """The disk fills while a run draws its figures: exit status 4, one line naming the
+    figure, summary.json 'failed' with every step done; the space freed, --restart finishes
+    the figures and the summary says 'completed' with all steps, t_final and final scalars."""
+    from damage_dolfinx.runtime import records
+    out = small_disk.path / "run"
+    args = ["run", "2.1-ex1", "--n", "5", "--k", "0.01", "--T", "0.05", "--quiet",
+            "--checkpoint-every", "5"]
+    with monkeypatch.context() as patch:
+        patch.setattr(records, "draw_figure", _full_then(small_disk, records.draw_figure))
+        status, _, err = _main(args, out, capsys)
+    assert status == 4, err
+    line = _one_line(err, "damage-dolfinx: output error: cannot write ")
+    assert ".png" in line and "No space left on device" in line, line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed" and summary["steps_done"] == 5
+    small_disk.free()
+    status, _, err = _main(args + ["--restart"], out, capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "completed" and summary["steps_done"] == 5
+    assert summary["t_final"] == pytest.approx(0.05) and summary["final"]
+    assert all((out / f["file"]).stat().st_size > 0 for f in summary["outputs"]["figures"])
+
+
+def test_full_disk_at_sweep_csv(small_disk, capsys, monkeypatch):
+    """The disk fills as sweep.csv is written: exit status 4, one line naming sweep.csv, the
+    sweep's summary 'failed'; the space freed, --restart writes the table of both points."""
+    out = small_disk.path / "sweep"
+    args = ["sweep", "2.1-ex1", "--set", "kappa=0.5,1", "--n", "5", "--T", "0.02",
+            "--no-figures", "--quiet"]
+    real = io.atomic_write_bytes
+
+    def write(path, *a, **kw):
+        if os.path.basename(path) == "sweep.csv":
+            small_disk.fill()
+        return real(path, *a, **kw)
+    with monkeypatch.context() as patch:
+        patch.setattr(io, "atomic_write_bytes", write)
+        status, _, err = _main(args, out, capsys)
+    assert status == 4, err
+    line = _one_line(err, "damage-dolfinx: output error: cannot write ")
+    assert "sweep.csv" in line and "No space left on device" in line, line
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "failed", summary
+    small_disk.free()
+    status, _, err = _main(args + ["--restart"], out, capsys)
+    assert status == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "completed" and summary["completed"] == 2
+    assert len((out / "sweep.csv").read_text().splitlines()) == 3

@@ -111,3 +111,43 @@ def test_restart_on_1_2_3_ranks_with_other_hash_seeds_is_accepted(tmp_path):
         assert len(lines) == 1 and item in lines[0] and "Traceback" not in proc.stderr, \
             proc.stderr
     assert json.loads((out / "summary.json").read_text())["steps_done"] == 6
+
+
+def _study_problem(law_factor=1.0, wide=2.0):
+    import ufl
+    import damage_dolfinx as dd
+    from damage_dolfinx.geometries.rectangle import rectangle, side
+
+    def mesh(comm, n):  # ``wide`` changes the finest level only
+        length = wide if n >= 8 else 2.0
+        return rectangle(comm, (0.0, 0.0), (length, 0.5), 4 * n, n,
+                         {1: side(0, 0.0), 2: side(0, length), 3: side(1, 0.0)})
+
+    return dd.Problem(model="2.2", mesh=mesh, n=2, T=0.04, k=0.01,
+                      boundaries={"clamped": 1, "traction": 2, "tresca": 3},
+                      traction=lambda x, t: ufl.as_vector((40.0 * t, 0.0)),
+                      damage_law=dd.DamageLaw(
+                          lambda e, z, p: -100.0 * law_factor * ufl.inner(e, e), "own"),
+                      params={"E": 2000.0, "g_fric": 10.0})
+
+
+def test_every_level_of_a_study_restart_checks_the_run_fingerprint(tmp_path, capsys):
+    """converge(restart=True): the same study has nothing to do; a changed law, or a mesh
+    family changed at its finest level only, is refused naming the item and the level, and
+    the study's files are unchanged."""
+    import damage_dolfinx as dd
+    out = tmp_path / "study"
+    levels = dict(n=[2, 4], k=[0.02], ref_n=8, ref_k=0.01, T=0.04, progress=False)
+    first = dd.converge(_study_problem(), out, **levels)
+    assert first["status"] == "completed" and set(first["fingerprints"]) == {"2", "4", "8"}
+    files = {f.name: f.read_bytes() for f in out.iterdir() if f.is_file()}
+    again = dd.converge(_study_problem(), out, restart=True, **levels)
+    assert again["errors"] == first["errors"] and "nothing to do" in capsys.readouterr().out
+    for problem, line in ((_study_problem(law_factor=2.0), "the damage law differs"),
+                          (_study_problem(wide=2.5), "the mesh differs")):
+        with pytest.raises(dd.InputError) as info:
+            dd.converge(problem, out, restart=True, **levels)
+        text = str(info.value)
+        assert text.startswith(f"cannot restart: {line} from the study in ") and \
+            "at the reference mesh n = 8" in text and "\n" not in text, text
+    assert {f.name: f.read_bytes() for f in out.iterdir() if f.is_file()} == files

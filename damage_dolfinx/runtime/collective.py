@@ -170,10 +170,51 @@ def mark(folder, exc, rank=None, kind=None):
     summary.update(status="failed" if status == "refused" else status, error=describe(exc))
     if rank is not None:
         summary["failed_rank"] = rank
+    from damage_dolfinx.runtime.atomic import write_json
     try:
-        from damage_dolfinx.runtime.atomic import write_json
         write_json(path, summary, MPI.COMM_SELF)
-    except Exception:  # noqa: BLE001 - the line and the exit status still tell
+        return
+    except Exception:  # noqa: BLE001 - a full disk: the reserve, else in place
+        pass
+    try:
+        if _free_reserve(folder):
+            write_json(path, summary, MPI.COMM_SELF)
+            return
+    except Exception:  # noqa: BLE001
+        pass
+    _in_place(path, summary)  # the line and the exit status tell in any case
+
+
+def _free_reserve(folder) -> bool:
+    """Give back the disk space the folder's lock reserves (runfolder.RunLock), when this
+    process holds it. True if space was freed."""
+    lock = Path(folder) / ".lock"
+    try:
+        with open(lock, "r+b") as f:
+            header = f.readline()
+            if not header.startswith(f"pid {os.getpid()} ".encode()) or \
+                    os.fstat(f.fileno()).st_size <= len(header):
+                return False
+            f.truncate(len(header))
+        return True
+    except OSError:
+        return False
+
+
+def _in_place(path, summary):
+    """The last resort on a full disk without a reserve: the status written over the existing
+    summary.json, within the blocks it already has (no new space needed). A kill during this
+    write leaves a summary that the next restart rebuilds from what is on disk."""
+    try:
+        text = (json.dumps(summary, indent=1, default=str) + "\n").encode()
+        with open(path, "r+b") as f:
+            if len(text) > os.fstat(f.fileno()).st_blocks * 512:
+                return
+            f.write(text)
+            f.truncate(len(text))
+            f.flush()
+            os.fsync(f.fileno())
+    except (OSError, ValueError):
         pass
 
 
