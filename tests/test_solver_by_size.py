@@ -50,7 +50,7 @@ def test_amg_above_the_threshold_gives_the_direct_answer(example, tmp_path):
 
 
 def test_bad_threshold_is_refused(tmp_path):
-    proc = run_cli(["run", "2.1-ex1", "--n", "4", "--T", "0.02", "--no-figures", "--quiet",
+    proc = run_cli(["run", "2.1-ex1", "--n", "5", "--T", "0.02", "--no-figures", "--quiet",
                     "--out", tmp_path / "bad", "-mech_amg_min_dofs", "many"], check=False)
     assert proc.returncode == 2
     assert "-mech_amg_min_dofs must be a whole number" in proc.stderr
