@@ -9,8 +9,8 @@ The public face (everything else is internal and may change):
   rank 0; :func:`steps`: the same run step by step in your script (the live Functions, your
   monitors, a stop on your criterion);
 * :class:`Model` (the base of every model: a model of your own derives from it, from the
-  building blocks of :mod:`damage_dolfinx.blocks`), :class:`SubStep`, :class:`ProblemData`
-  (what a model is built from), :func:`register_model`, :func:`model_class` (a model's class
+  building blocks of :mod:`damage_dolfinx.blocks`), :class:`SubStep`
+  (a model is built from a :class:`Problem` whose mesh is built), :func:`register_model`, :func:`model_class` (a model's class
   by id);
 * :class:`DamageLaw` and the thesis laws :data:`THESIS_A`, :data:`THESIS_B`;
 * :func:`read_run`: a run folder back into a script (summary, history arrays, fields at any
@@ -28,12 +28,12 @@ Names are imported on first use, so ``import damage_dolfinx`` stays light.
 __version__ = "0.1.0"
 
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
-           "Model", "SubStep", "ProblemData", "register_model", "model_class", "blocks",
+           "Model", "SubStep", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
            "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run"]
 
 _WHERE = {"Problem": "problem", "run": "workflow", "steps": "workflow", "Model": "models.base",
-          "SubStep": "models.base", "ProblemData": "models.base", "converge": "workflow",
+          "SubStep": "models.base", "converge": "workflow",
           "sweep": "workflow", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
           "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
           "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results",

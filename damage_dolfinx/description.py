@@ -1,10 +1,11 @@
-"""The run description: what one run is (model, mesh, data, time grid, boundaries, figures),
-validated and configured once, then built into a model on the run's ranks.
+"""The run description's stages and the catalogue's examples.
 
-A :class:`~damage_dolfinx.Problem` resolves to one (:meth:`Problem.example`); a catalogue example
-is the same description with the thesis's metadata filled in (section, readings with their
-departures, figures, default convergence study). The run machinery (``runtime/``) takes it as
-it is, without knowing where it came from.
+A run is a :class:`~damage_dolfinx.Problem` (problem.py). :func:`configure` decides the values
+of one run (validated data, time grid, mesh level and file) and :func:`build` builds its mesh on
+the run's ranks and the model from it. A catalogue example (:class:`Example`) is a Problem with
+the thesis's metadata: section, readings with their departures, figures, default convergence
+study; the run machinery (``runtime/``) takes any Problem as it is, without knowing where it
+came from.
 
 Readings (``--reading literal|evidence``): ``literal`` is exactly the stated thesis
 data (the catalogue entry itself); ``evidence`` replaces some of it by the values that reproduce
@@ -20,8 +21,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
-from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
-from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.parameters import InputError, TimeGrid
+from damage_dolfinx.problem import MAX_STEPS, READINGS, Problem  # noqa: F401
 
 
 @dataclass
@@ -39,13 +40,6 @@ class Figure:
     mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
 
 
-#: more time steps than this need the parameter allow_long (--allow-long)
-MAX_STEPS = 10_000_000
-
-#: the readings of the thesis data (``--reading``)
-READINGS = ("literal", "evidence")
-
-
 @dataclass
 class Reading:
     """Departures of one reading from the stated data: parameter values, loads, and the
@@ -57,42 +51,27 @@ class Reading:
 
 
 @dataclass
-class Example:
-    """One run description (a catalogue example, or a Problem resolved)."""
-    id: str
-    title: str
-    section: str
-    params: ModelParameters
-    T: float
-    k: float
-    make_geometry: Callable          # (comm, n, h) -> Geometry
-    model: object                    # the model: an id ("2.1" ... "3.3") or a Model class
-    diameter: float
-    n: Optional[int] = None          # structured meshes: cells per side
+class Example(Problem):
+    """A thesis example: a :class:`~damage_dolfinx.Problem` (``name`` its id, ``mesh`` a
+    family ``(comm, n, h) -> Geometry``, ``params`` the full data) with the thesis's metadata.
+    Its default k follows the mesh (:meth:`default_k`) and its own k runs as the thesis ran it
+    (a warning above k_max); a k you choose above k_max is refused."""
+    title: str = ""
+    section: str = ""
+    diameter: float = math.nan       # the body's diameter (nan: measured on the mesh)
     h: Optional[float] = None        # gmsh meshes: element size
     dim: int = 2                     # space dimension of the mesh (3: the 3-D examples)
-    body_force: Optional[Callable] = None
-    traction: Optional[Callable] = None
-    zeta0: object = 1.0
     assumptions: list = field(default_factory=list)
     figures: list = field(default_factory=list)
     convergence: Optional[dict] = None  # default study {ref_n, ref_k, n: [...], k: [...]}
-    builders: dict = field(default_factory=dict)  # problem-specific builders (ProblemData)
     readings: dict = field(default_factory=dict)  # {"evidence": Reading} (literal = the data)
     default_reading: str = "literal"
     reading: Optional[str] = None                 # the reading applied (None: the raw entry)
     literal: Optional["Example"] = field(default=None, repr=False, compare=False)
-    damage_law: Optional[object] = None           # laws.DamageLaw (None: the thesis law)
-    irreversible: bool = False                    # zeta_n <= zeta_{n-1}
-    boundaries: Optional[dict] = None             # role -> tags (None: tags 1, 2, 3 as they are)
-    own: bool = False                             # an own problem (Problem), not the catalogue
-    allow_unstable: bool = False                  # a k above k_max: a warning, not a refusal
+    mesh_file: Optional[str] = None               # a gmsh file replacing the mesh (--mesh)
     _requirements: Optional[tuple] = field(default=None, repr=False, compare=False)
 
-    @property
-    def model_id(self) -> str:
-        """The id of the example's model (its ``model`` may be the class itself)."""
-        return self.model if isinstance(self.model, str) else self.model.id
+    own = False
 
     def with_reading(self, name=None) -> "Example":
         """This example under reading ``name`` (None: the default); raises InputError."""
@@ -112,6 +91,10 @@ class Example:
             assumptions=[f"reading: {name} ({label}; {departures})"] + base.assumptions
             + r.assumptions, reading=name, literal=base)
 
+    def checked(self) -> "Example":
+        """The example under its reading (the default one when none is applied yet)."""
+        return self if self.reading is not None else self.with_reading(None)
+
     def _resolved(self, overrides):
         """(example under the reading named in ``overrides``, overrides without it)."""
         overrides = dict(overrides or {})
@@ -120,102 +103,23 @@ class Example:
             return self.with_reading(name), overrides
         return self, overrides
 
-    def configure(self, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
-                  comm=None):
-        """Validated (params, time grid, n, h, mesh_file) for a run; raises InputError.
-        ``overrides`` may name the reading (key ``reading``). ``comm``: the ranks of the run
-        (default all), which the memory check is collective on."""
-        ex, overrides = self._resolved(overrides)
-        if ex is not self:
-            return ex.configure(n, k, T, h, overrides, mesh_file, comm)
-        overrides = dict(overrides or {})
-        allow_long = bool(overrides.pop("allow_long", False))
-        from damage_dolfinx.models.registry import model as model_info
-        info = model_info(self.model)
-        # a time step you choose above k_max is refused (stability_check = error) unless the
-        # check is set explicitly (--allow-unstable sets warn); the thesis's own steps (defaults,
-        # convergence tables) run as the thesis ran them, with a warning above k_max
-        action = overrides.pop("stability_check", None) \
-            if "stability_check" not in self.params.extra else overrides.get("stability_check")
-        if action is None:
-            action = "error" if (k is not None or self.own) and not self.allow_unstable \
-                else "warn"
-            if "stability_check" in self.params.extra and k is not None:
-                overrides["stability_check"] = action
-        from damage_dolfinx.models.registry import validate
-        params = validate(info, self.params.replace(**overrides))
-        T = self.T if T is None else float(T)
-        if k is None and self.own:  # an own problem's k is its author's choice
-            k = self.k
-        k = self.default_k(n, h, T, params) if k is None else float(k)
-        time = TimeGrid(k, T)
-        k_max = info.k_max(params)
-        if k > k_max:
-            from damage_dolfinx.numerics.stability import check_time_step
-            check_time_step(k, k_max, f"{self.id}: {info.stability_limit}", action=action)
-        if n is not None and self.n is None:
-            raise InputError(f"example {self.id} uses a gmsh mesh: set its size with --h, not --n")
-        if h is not None and self.h is None:
-            raise InputError(f"example {self.id} uses a structured mesh: set it with --n, not --h")
-        n = self.n if n is None else int(n)
-        h = self.h if h is None else float(h)
-        if n is not None and n < 1:
-            raise InputError(f"number of cells per side n must be >= 1, got n = {n}")
-        if h is not None and not h > 0:
-            raise InputError(f"mesh size h must be positive, got h = {h}")
-        if mesh_file is not None and not Path(mesh_file).is_file():
-            from damage_dolfinx.validation import mesh_path_problem
-            raise InputError(f"mesh file {str(mesh_file)!r} "
-                             f"{mesh_path_problem(Path(mesh_file)) or 'is not a file'}")
-        if time.num_steps > MAX_STEPS and not allow_long:
-            raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
-                             f"{MAX_STEPS:.0e}; choose a larger k, or allow_long=True")
-        if mesh_file is not None and self.dim != 2:
-            raise InputError(f"--mesh reads 2-D gmsh meshes; example {self.id} is {self.dim}-D")
-        if mesh_file is None and not self.own:
-            from mpi4py import MPI
-            from damage_dolfinx.runtime.resources import check_memory
-            # a mesh that cannot fit is refused now (collective on the run's ranks: a serial
-            # cell of a convergence study is built on one rank alone)
-            check_memory(self, n, h, comm or MPI.COMM_WORLD)
-        return params, time, n, h, mesh_file
+    def make_geometry(self, comm, n=None, h=None):
+        """The example's own mesh at size n (structured) or h (gmsh) on ``comm``."""
+        from damage_dolfinx.meshes import as_geometry
+        return as_geometry(self.mesh(comm, n, h) if self.family else self.mesh, comm)
 
     def mesh_requirements(self):
         """(dimension, facet tags) a --mesh file must have: those of the built-in geometry
         (built serially at the default size, once per example; runfolder.check_mesh_file and
         required_tags both ask)."""
-        if self._requirements is None:
+        base = self.literal or self  # the entry as written (default size), shared by readings
+        if base._requirements is None:
             import numpy as np
             from mpi4py import MPI
-            geometry = self.make_geometry(MPI.COMM_SELF, self.n, self.h)
-            self._requirements = (self.dim, tuple(int(t) for t in
+            geometry = base.make_geometry(MPI.COMM_SELF, base.n, base.h)
+            base._requirements = (base.dim, tuple(int(t) for t in
                                                   np.unique(geometry.facet_tags.values)))
-        return self._requirements
-
-    def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
-              configured=None):
-        """Mesh, data and model of one run; ``configured``: what :meth:`configure` returned
-        for the same arguments (None: configured here)."""
-        ex, overrides = self._resolved(overrides)
-        if ex is not self:
-            return ex.build(comm, n, k, T, h, overrides, mesh_file, configured)
-        params, time, n, h, mesh_file = configured or \
-            self.configure(n, k, T, h, overrides, mesh_file, comm)
-        from damage_dolfinx.meshes import read_mesh, retag
-        if mesh_file is not None:
-            geometry = read_mesh(mesh_file, comm, self.dim)
-            required = self.required_tags(comm)
-        else:
-            geometry = self.make_geometry(comm, n, h)
-            required = None
-        from damage_dolfinx.models.registry import model as model_info
-        geometry = retag(geometry, self.boundaries, required, model_info(self.model))
-        data = ProblemData(self.id, geometry, params, time, self.body_force, self.traction,
-                           self.zeta0, self.builders, self.damage_law, self.irreversible)
-        from damage_dolfinx.validation import check_data
-        check_data(data)  # loads, law, zeta0 against the mesh (validation.py)
-        from damage_dolfinx.models.registry import model as model_info
-        return model_info(self.model)(data)
+        return base._requirements
 
     def default_k(self, n, h, T, params) -> float:
         """The default time step at mesh (n, h) and final time T: the example's k, made smaller
@@ -246,3 +150,85 @@ class Example:
         names = {CLAMPED: "clamped (Gamma_D)", TRACTION: "traction (Gamma_N)",
                  CONTACT: "contact (Gamma_C)"}
         return {names[t]: t for t in (CLAMPED, TRACTION, CONTACT) if t in tags}
+
+
+def configure(ex: Problem, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+              comm=None) -> Problem:
+    """``ex`` (under its reading) as one run has it: validated data, T, k, the mesh level and
+    file; InputError otherwise (see :meth:`Problem.configure`)."""
+    overrides = dict(overrides or {})
+    allow_long = bool(overrides.pop("allow_long", False))
+    from damage_dolfinx.models.registry import model as model_info, validate
+    info = model_info(ex.model)
+    # a time step you choose above k_max is refused (stability_check = error) unless the
+    # check is set explicitly (--allow-unstable sets warn); the thesis's own steps (defaults,
+    # convergence tables) run as the thesis ran them, with a warning above k_max
+    action = overrides.pop("stability_check", None) \
+        if "stability_check" not in ex.params.extra else overrides.get("stability_check")
+    if action is None:
+        action = "error" if (k is not None or ex.own) and not ex.allow_unstable \
+            else "warn"
+        if "stability_check" in ex.params.extra and k is not None:
+            overrides["stability_check"] = action
+    # validated once: a checked problem's data again only when a run changes them
+    params = ex.params if ex._checked and not overrides else \
+        validate(info, ex.params.replace(**overrides))
+    T = ex.T if T is None else float(T)
+    k = ex.default_k(n, h, T, params) if k is None else float(k)
+    time = TimeGrid(k, T)
+    k_max = info.k_max(params)
+    if k > k_max:
+        from damage_dolfinx.numerics.stability import check_time_step
+        check_time_step(k, k_max, f"{ex.id}: {info.stability_limit}", action=action)
+    if n is not None and ex.n is None:
+        raise InputError(f"example {ex.id} uses a gmsh mesh: set its size with --h, not --n")
+    if h is not None and ex.h is None:
+        raise InputError(f"example {ex.id} uses a structured mesh: set it with --n, not --h")
+    n = ex.n if n is None else int(n)
+    h = ex.h if h is None else float(h)
+    if n is not None and n < 1:
+        raise InputError(f"number of cells per side n must be >= 1, got n = {n}")
+    if h is not None and not h > 0:
+        raise InputError(f"mesh size h must be positive, got h = {h}")
+    if mesh_file is not None and not Path(mesh_file).is_file():
+        from damage_dolfinx.validation import mesh_path_problem
+        raise InputError(f"mesh file {str(mesh_file)!r} "
+                         f"{mesh_path_problem(Path(mesh_file)) or 'is not a file'}")
+    if time.num_steps > MAX_STEPS and not allow_long:
+        raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
+                         f"{MAX_STEPS:.0e}; choose a larger k, or allow_long=True")
+    if mesh_file is not None and ex.dim != 2:
+        raise InputError(f"--mesh reads 2-D gmsh meshes; example {ex.id} is {ex.dim}-D")
+    if mesh_file is None and not ex.own:
+        from mpi4py import MPI
+        from damage_dolfinx.runtime.resources import check_memory
+        # a mesh that cannot fit is refused now (collective on the run's ranks: a serial
+        # cell of a convergence study is built on one rank alone)
+        check_memory(ex, n, h, comm or MPI.COMM_WORLD)
+    sized = dict(n=n, h=h, mesh_file=str(mesh_file) if mesh_file is not None else None) \
+        if not ex.own else dict(n=n)
+    return dataclasses.replace(ex, params=params, T=T, k=k, _checked=True, **sized)
+
+
+def on_mesh(c: Problem, comm) -> Problem:
+    """The configured problem ``c`` on its mesh on ``comm`` (the problem's own, or the mesh file
+    replacing it, with the example's tags required), the boundary roles named, checked against
+    the loads, law and initial damage: what a model is built from (no solver set up)."""
+    from damage_dolfinx.meshes import read_mesh, retag
+    from damage_dolfinx.models.registry import model
+    from damage_dolfinx.validation import check_data
+    if c.mesh_file is not None:
+        geometry = read_mesh(c.mesh_file, comm, c.dim)
+        required = c.required_tags(comm)
+    else:
+        geometry = c.make_geometry(comm, c.n, c.h)
+        required = None
+    built = dataclasses.replace(c, mesh=retag(geometry, c.boundaries, required, model(c.model)))
+    check_data(built)  # loads, law, zeta0 against the mesh (validation.py)
+    return built
+
+
+def build(c: Problem, comm):
+    """The model of the configured problem ``c`` on ``comm``, built on :func:`on_mesh`."""
+    from damage_dolfinx.models.registry import model
+    return model(c.model)(on_mesh(c, comm))

@@ -88,6 +88,8 @@ def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
 def from_gmsh(model=None, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     """The mesh of a gmsh model (default: the current ``gmsh.model``, meshed, on rank 0)."""
     from damage_dolfinx import compat
+    from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
+    import_gmsh_keeping_sigint()
     import gmsh
     from damage_dolfinx.validation import check_dim
     check_dim(dim)

@@ -1,5 +1,6 @@
-"""Your own problem: one of the models on your mesh, with your boundary parts, loads, data and
-damage law. Run it with :func:`damage_dolfinx.run` (summary.json, XDMF, history.csv, checkpoints
+"""A run: one of the models on a mesh, with its boundary parts, loads, data and damage law
+(:class:`Problem`). Your own problems are Problems; a thesis example of the catalogue is a
+Problem with its thesis metadata (:class:`damage_dolfinx.description.Example`). Run it with :func:`damage_dolfinx.run` (summary.json, XDMF, history.csv, checkpoints
 and restart, signals, figures, MPI) or study its convergence with :func:`damage_dolfinx.converge`.
 
 Example: the Kelvin-Voigt model with Tresca friction (``"2.2"``) on a rectangle clamped on the
@@ -26,14 +27,30 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable, Optional, Union
 
-from damage_dolfinx.parameters import InputError, ModelParameters
+from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
+
+#: more time steps than this need the parameter allow_long (--allow-long)
+MAX_STEPS = 10_000_000
+
+#: the readings of the thesis data (``--reading``); a problem without an evidence reading has
+#: evidence = literal
+READINGS = ("literal", "evidence")
 
 
 @dataclass
 class Problem:
-    """One of the models on your mesh, with your data.
+    """One run: a model on a mesh, with its data, loads and time grid.
+
+    The same object goes through the three stages of a run: as you write it (a mesh family,
+    changes to the model's defaults, k perhaps None), :meth:`checked` (every argument
+    validated, once), :meth:`configure` (the values of one run: validated data, k, T, mesh
+    level) and :meth:`build` on the run's ranks, which gives the model the problem with its mesh
+    built (``mesh`` a :class:`~damage_dolfinx.geometries.Geometry`): that is what a
+    :class:`~damage_dolfinx.Model` is built from, and what it reads as ``self.data``
+    (``geometry``, ``params``, ``time``, the loads, ``zeta0``, ``builders``, ...).
 
     Attributes:
         model: a model id, a key of :data:`damage_dolfinx.MODELS` (which lists them with
@@ -85,6 +102,69 @@ class Problem:
     name: str = "problem"
     builders: dict = field(default_factory=dict)
     allow_unstable: bool = False
+    _checked: bool = field(default=False, repr=False, compare=False)
+
+    # -- what the run machinery reads besides the fields; a catalogue example
+    #    (description.Example) holds these as its thesis metadata (fields that take the place
+    #    of the class values and of the derived values below, cached_property being overridable)
+    own = True              # your problem: a k you give above k_max is refused
+    dim = 0                 # the space dimension, known once the mesh is built
+    h = None                # the element size of a gmsh mesh family (catalogue)
+    mesh_file = None        # a gmsh file replacing the mesh of a catalogue example (--mesh)
+    diameter = math.nan     # the body's diameter (nan: measured on the mesh)
+    convergence = None      # a default convergence study
+    readings = {}           # readings beyond the literal data (none)
+    reading = "literal"
+    default_reading = "literal"
+
+    @property
+    def id(self) -> str:
+        """The run's name in its records."""
+        return self.name
+
+    @property
+    def model_id(self) -> str:
+        """The id of the problem's model (``model`` may be the class itself)."""
+        return self.model if isinstance(self.model, str) else self.model.id
+
+    @cached_property
+    def title(self) -> str:
+        from damage_dolfinx.models.registry import model
+        return f"{model(self.model).title} (own problem)"
+
+    @cached_property
+    def section(self) -> str:
+        return self.model_id
+
+    @cached_property
+    def assumptions(self) -> list:
+        law = self.damage_law.name if self.damage_law is not None else \
+            f"thesis variant {getattr(self.params, 'variant', '?')}"
+        from damage_dolfinx.models.registry import model
+        return [f"own problem, model {self.model_id}: {model(self.model).title}",
+                f"damage law: {law}" + (", irreversible (zeta_n <= zeta_{n-1})"
+                                        if self.irreversible else "")]
+
+    @cached_property
+    def figures(self) -> list:
+        from damage_dolfinx.description import Figure
+        return [Figure("fields_final.png", f"{self.name}: von Mises stress and damage")]
+
+    # -- what a model reads of the problem it is built from
+    @property
+    def geometry(self):
+        """The mesh as a :class:`~damage_dolfinx.geometries.Geometry` (a problem on one mesh:
+        a Geometry or a ``(mesh, facet_tags)`` pair, as :meth:`build` gives it to the model)."""
+        from damage_dolfinx.meshes import as_geometry
+        if callable(self.mesh) and not isinstance(self.mesh, tuple):
+            raise InputError(f"{self.name}: a mesh family has no geometry until it is built "
+                             "(Problem.build or damage_dolfinx.run)")
+        return as_geometry(self.mesh)
+
+    @cached_property
+    def time(self) -> TimeGrid:
+        """The time grid t_n = n k, n = 0 ... T/k."""
+        return TimeGrid(float(self.k), float(self.T))
 
     def k_max(self, comm=None) -> float:
         """The time-step limit of the scheme's explicit terms for this mesh and data (inf: none);
@@ -112,50 +192,83 @@ class Problem:
         p = info.with_roles(p, set(self.boundaries or {}))
         return validate(info, p)
 
-    def example(self):
-        """The run description the run machinery takes (internal)."""
-        from damage_dolfinx.description import Example, Figure
-        from damage_dolfinx.laws import DamageLaw
-        from damage_dolfinx.meshes import as_geometry
+    # -- the stages of a run
+    def checked(self) -> "Problem":
+        """This problem with every argument validated, before any work (InputError with one
+        line otherwise): the data resolved against the model's defaults, k chosen (None: the
+        largest below 0.8 k_max and T/100 that divides T), the family level required. Done once:
+        a checked problem returns itself."""
+        if self._checked:
+            return self
         from damage_dolfinx.models.registry import model
         from damage_dolfinx.validation import check_problem
-        self = check_problem(self)  # every argument, before any work (validation.py)
-        info = model(self.model)
-        if self.damage_law is not None and not isinstance(self.damage_law, DamageLaw):
-            raise InputError("damage_law must be a damage_dolfinx.DamageLaw "
-                             "(DamageLaw(function, name))")
-        if not (isinstance(self.T, (int, float)) and math.isfinite(self.T) and self.T > 0):
-            raise InputError(f"final time T must be a positive number, got T = {self.T!r}")
-        params = self.parameters()
-        k = self.k
+        problem = check_problem(self)  # every argument, before any work (validation.py)
+        info = model(problem.model)
+        params = problem.parameters()
+        k = problem.k
         if k is None:
             if info.dynamic:
                 raise InputError(f"model {info.id} needs a time step k below its limit k_max, "
                                  "which depends on the mesh and data: problem.k_max() gives it")
-            k = min(self.T / 100.0, 0.8 * info.k_max(params))
-            k = self.T / math.ceil(self.T / k * (1 - 1e-12))
-        family = callable(self.mesh) and not isinstance(self.mesh, tuple)
-        n = self.n if family else None
-        if family and n is None:
+            k = min(problem.T / 100.0, 0.8 * info.k_max(params))
+            k = problem.T / math.ceil(problem.T / k * (1 - 1e-12))
+        if problem.family and problem.n is None:
             raise InputError("a mesh family (comm, n) -> mesh needs the level n (Problem(n=...))")
-        mesh = self.mesh
-
-        def make_geometry(comm, n_, h_):
-            return as_geometry(mesh(comm, n_) if family else mesh, comm)
-
         if params.extra.get("stability_check") is not None:
-            params = params.replace(stability_check="warn" if self.allow_unstable else "error")
-        law = self.damage_law.name if self.damage_law is not None else \
-            f"thesis variant {params.variant}"
-        return Example(
-            id=self.name, title=f"{info.title} (own problem)", section=info.id, params=params,
-            T=float(self.T), k=float(k), make_geometry=make_geometry, model=info,
-            diameter=math.nan, n=n, dim=0, body_force=self.body_force, traction=self.traction,
-            zeta0=self.zeta0, builders=dict(self.builders), damage_law=self.damage_law,
-            irreversible=bool(self.irreversible), boundaries=self.boundaries, own=True,
-            allow_unstable=bool(self.allow_unstable),
-            assumptions=[f"own problem, model {info.id}: {info.title}",
-                         f"damage law: {law}" + (", irreversible (zeta_n <= zeta_{n-1})"
-                                                 if self.irreversible else "")],
-            figures=[Figure("fields_final.png", f"{self.name}: von Mises stress and damage")],
-            reading="literal")
+            params = params.replace(stability_check="warn" if problem.allow_unstable else "error")
+        return dataclasses.replace(problem, params=params, T=float(problem.T), k=float(k),
+                                   n=problem.n if problem.family else None, _checked=True)
+
+    @property
+    def family(self) -> bool:
+        """Whether ``mesh`` is a mesh family (a function of the ranks and the level)."""
+        return callable(self.mesh) and not isinstance(self.mesh, tuple)
+
+    def with_reading(self, name=None) -> "Problem":
+        """This problem under reading ``name``: a problem of your own has its data only
+        (evidence = literal)."""
+        if (name or "literal") not in READINGS:
+            raise InputError(f"unknown reading {name!r}; known: {', '.join(READINGS)}")
+        return self
+
+    def _resolved(self, overrides):
+        """(the problem under the reading named in ``overrides``, overrides without it)."""
+        overrides = dict(overrides or {})
+        return self.with_reading(overrides.pop("reading", None)), overrides
+
+    def configure(self, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+                  comm=None) -> "Problem":
+        """The problem as one run has it (validated data, T, k, the mesh level and file), or
+        InputError. ``overrides`` may name the reading (key ``reading``). ``comm``: the ranks of
+        the run (default all), which the memory check is collective on."""
+        from damage_dolfinx.description import configure
+        ex, overrides = self._resolved(overrides)
+        return configure(ex, n, k, T, h, overrides, mesh_file, comm)
+
+    def default_k(self, n, h, T, params) -> float:
+        """The time step when none is given for the run: the problem's own (an own problem's k
+        is its author's choice, decided by :meth:`checked`)."""
+        return self.k
+
+    def make_geometry(self, comm, n=None, h=None):
+        """The problem's own mesh on ``comm`` (a family at level n)."""
+        from damage_dolfinx.meshes import as_geometry
+        return as_geometry(self.mesh(comm, n) if self.family else self.mesh, comm)
+
+    def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+              configured=None):
+        """The model of one run on ``comm`` (its mesh built); ``configured``: what
+        :meth:`configure` returned for the same arguments (None: configured here)."""
+        from damage_dolfinx.description import build
+        return build(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
+
+    def problem_data(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
+                     configured=None) -> "Problem":
+        """The configured problem on its mesh on ``comm``, checked: what a model is built from
+        (no solver set up; the run fingerprint reads it)."""
+        from damage_dolfinx.description import on_mesh
+        return on_mesh(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
+
+    def mesh_requirements(self):
+        """(dimension, facet tags) a --mesh file must have (a catalogue example's)."""
+        raise InputError(f"{self.name}: a problem of your own takes its mesh as Problem(mesh=...)")

@@ -114,7 +114,7 @@ def path(name, value, allow_none=False):
 # ---------------------------------------------------------------------------- Problem
 def check_problem(problem):
     """The problem with its scalars normalised (NumPy scalars to Python), or InputError.
-    Called where the Problem is turned into a run (``Problem.example``)."""
+    Called where the Problem is turned into a run (``Problem.checked``)."""
     from damage_dolfinx.laws import DamageLaw
     from damage_dolfinx.models.registry import MODELS, model as model_class
     from damage_dolfinx.parameters import ModelParameters

@@ -3,8 +3,9 @@ Your own model: Kelvin-Voigt with normal compliance
 ===================================================
 
 A model is one class: it declares what it is (id, contact roles, checkpointed fields, history
-columns, sub-steps, stability limit, default data) and builds its unknowns and solvers from the
-public building blocks of :mod:`damage_dolfinx.blocks`. Here model 2.2 (quasistatic
+columns, sub-steps, explicit update, stability limit, default data) and builds its unknowns and
+solvers from the public building blocks of :mod:`damage_dolfinx.blocks`; the step itself is the
+package's (old state copied, sub-steps in order, explicit update). Here model 2.2 (quasistatic
 Kelvin-Voigt body with damage) with the Tresca friction of its contact boundary replaced by
 normal compliance :math:`p_\nu(r) = c_\nu r_+`, written in this script, without touching the
 package. The scheme, at each step :math:`t_{n-1} \to t_n`:
@@ -53,7 +54,7 @@ class CompliantKelvinVoigt(dd.Model):
     stability_limit = "explicit elastic term: k <= 2/m_visc"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("contact_force",)
-    scheme = (("damage", "snes-vi", "damage_"), ("mech", "semismooth", "mech_"))
+    update = ("u", "u_old", "v")                # (3) u_n = u_{n-1} + k v_n (after u -> u_old)
     contact_quadrature_degree = 2               # p_nu has kinks: one rule for all contact terms
 
     @classmethod
@@ -71,14 +72,14 @@ class CompliantKelvinVoigt(dd.Model):
         V, Z = b.vector_p1(msh), b.scalar_p1(msh)
         self.u, self.u_old, self.v = (fem.Function(V, name=s) for s in ("u", "u_old", "v"))
         self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
-        self.k = data.time.k
+        k = data.time.k
         self.damage = self.obstacle_damage_step()                        # (1)
         tags = data.geometry.facet_tags
         ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
         dsC = ds(3, metadata={"quadrature_degree": self.contact_quadrature_degree})
         self.n_facet, self.c_nu, self.gap = ufl.FacetNormal(msh), x["c_nu"], x["gap"]
         w, v, nu_ = ufl.TestFunction(V), self.v, self.n_facet
-        r = ufl.dot(self.u_old + self.k * v, nu_) - self.gap
+        r = ufl.dot(self.u_old + k * v, nu_) - self.gap
         p_nu = self.c_nu * ufl.conditional(ufl.ge(r, 0.0), r, 0.0)      # Jacobian 1 at r = 0
         F = (ufl.inner(b.viscous_stress(v, p.E, p.nu, x["m_visc"]), b.eps(w)) * ufl.dx
              + ufl.inner(b.damaged_elastic_stress(self.u_old, self.zeta_old, p.E, p.nu,
@@ -94,13 +95,9 @@ class CompliantKelvinVoigt(dd.Model):
         self._vm = b.expression(b.von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
 
-    def _advance(self):
-        self.u_old.x.array[:] = self.u.x.array
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        damage_its = self.damage.solve()
-        snes_its = self.mech.solve()
-        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array  # (3)
-        return {"damage_its": damage_its, "snes_its": snes_its}
+    def scheme(self):
+        return (dd.SubStep("damage", "snes-vi", "damage_", self.damage.solve, ("damage_its",)),
+                dd.SubStep("mech", "semismooth", "mech_", self.mech.solve, ("snes_its",)))
 
     def contact_pressure(self):
         return b.normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)

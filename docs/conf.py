@@ -4,7 +4,7 @@ Three pages are generated here at every build, from the code itself, into ``_gen
 (not kept in git) and included by their page:
 
 - ``cli.md``: ``damage-dolfinx --help`` and the help of every subcommand, from the argparse
-  parser of ``damage_dolfinx/cli.py``;
+  parser of the ``damage_dolfinx.cli`` package;
 - ``api.md``: one autodoc entry per name in ``damage_dolfinx.__all__`` (functions, classes,
   modules, data), so a name added to ``__all__`` is documented without touching the docs;
 - ``records.md``: ``benchmarks/README.md`` with its headings one level down;

@@ -36,8 +36,15 @@ class _LazyGmsh:
     a built-in mesh never needs (the geometry modules are imported with the catalogue)."""
 
     def __getattr__(self, name):
-        import gmsh
-        return getattr(gmsh, name)
+        return getattr(_gmsh(), name)
+
+
+def _gmsh():
+    """The gmsh module, imported keeping the SIGINT handler (runtime.signals)."""
+    from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
+    import_gmsh_keeping_sigint()
+    import gmsh
+    return gmsh
 
 
 #: ``from damage_dolfinx.geometries import lazy_gmsh as gmsh`` in the gmsh-built geometries
@@ -47,7 +54,7 @@ lazy_gmsh = _LazyGmsh()
 def gmsh_session():
     """Initialise gmsh once per process (gmsh 4.8 has no isInitialized) and silence it."""
     global _gmsh_ready
-    import gmsh
+    gmsh = _gmsh()
     if not _gmsh_ready:
         gmsh.initialize()
         gmsh.option.setNumber("General.Terminal", 0)

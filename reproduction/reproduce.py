@@ -96,11 +96,18 @@ def figure_jobs(mode: str, reading=None) -> list:
         if ex.id in SKIP_RUN or not ex.figures:
             continue
         base = (_quick_options(ex) if mode == "quick" else []) + _reading_options(reading)
-        for variant, sets in (VARIANTS.get(ex.id) or {"": {}}).items():
-            options = list(base)
-            for key, value in sets.items():
-                options += ["--set", f"{key}={value}"]
-            jobs.append(Job(ex.id, variant, options))
+        jobs += _variant_jobs(ex.id, base)
+    return jobs
+
+
+def _variant_jobs(example_id: str, base: list) -> list:
+    """One Job per variant of an example (its ``--set`` options after the common ``base``)."""
+    jobs = []
+    for variant, sets in (VARIANTS.get(example_id) or {"": {}}).items():
+        options = list(base)
+        for key, value in sets.items():
+            options += ["--set", f"{key}={value}"]
+        jobs.append(Job(example_id, variant, options))
     return jobs
 
 
@@ -120,11 +127,7 @@ def convergence_jobs(mode: str, reading=None) -> list:
         else:
             base = []
         base += _reading_options(reading)
-        for variant, sets in (VARIANTS.get(ex.id) or {"": {}}).items():
-            options = list(base)
-            for key, value in sets.items():
-                options += ["--set", f"{key}={value}"]
-            jobs.append(Job(ex.id, variant, options))
+        jobs += _variant_jobs(ex.id, base)
     return jobs
 
 

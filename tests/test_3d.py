@@ -147,13 +147,13 @@ def uniaxial_block(k, s0, lam_plus, lam_minus, T=1.0, n=2, comm=MPI.COMM_WORLD):
     on x = 1, lam_D = 0: a homogeneous uniaxial strain eps = diag(e, 0, 0), e = s/(zeta M).
     Returns (times, zeta per step, e per step, largest deviation from homogeneity)."""
     from damage_dolfinx.geometries.box_with_hole import block
-    from damage_dolfinx.parameters import ModelParameters, TimeGrid
-    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.parameters import ModelParameters
+    from damage_dolfinx.problem import Problem
     from damage_dolfinx.models.elastic_2_1 import ElasticDamage
     params = ModelParameters(E=E, nu=NU, kappa=1.0, zeta_star=0.01, q_star=1e3, variant="B",
                              lam_D=0.0, lam_u_plus=lam_plus, lam_u_minus=lam_minus,
                              stop_at_zeta_star=False).validate()
-    data = ProblemData("uniaxial-3d", block(comm, n), params, TimeGrid(k, T),
+    data = Problem("2.1", block(comm, n), T, k=k, params=params, name="uniaxial-3d",
                        traction=lambda x, t: ufl.as_vector((s0 * t, 0.0, 0.0)))
     st = ElasticDamage(data)
     X = st.u.function_space.tabulate_dof_coordinates()
@@ -257,8 +257,7 @@ def test_thin_plate_tends_to_plane_stress():
     order, and the difference must fall by a factor >= 1.5 at each halving."""
     from damage_dolfinx.catalogue import examples
     from damage_dolfinx.geometries.box_with_hole import box_with_hole
-    from damage_dolfinx.parameters import TimeGrid
-    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.problem import Problem
     from damage_dolfinx.models.elastic_2_1 import ElasticDamage
     comm = MPI.COMM_SELF
     ex = examples.get("2.1-ex1")
@@ -269,9 +268,9 @@ def test_thin_plate_tends_to_plane_stress():
         s2.advance()
         X = s2.u.function_space.tabulate_dof_coordinates()
         u2 = s2.u.x.array.reshape(-1, 2)
-        data = ProblemData("plate-3d", box_with_hole(comm, n, height=H, nz=1, hole_z=None),
-                           ex.params, TimeGrid(0.1, 0.1),
-                           body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t, 0.0)))
+        data = Problem("2.1", box_with_hole(comm, n, height=H, nz=1, hole_z=None), 0.1, k=0.1,
+                       params=ex.params, name="plate-3d",
+                       body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t, 0.0)))
         s3 = ElasticDamage(data)
         s3.initialize()
         s3.advance()

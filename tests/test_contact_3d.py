@@ -167,8 +167,8 @@ def test_dynamic_block_contact_force_balance(n):
     P = int v_z dx: it must hold at every step to the solver tolerance, as must the zero x- and
     y-momentum. n = 3: factorised velocity matrix; n = 10 (3993 unknowns): CG + GAMG."""
     from damage_dolfinx.geometries.box import box, face
-    from damage_dolfinx.parameters import ModelParameters, TimeGrid
-    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.parameters import ModelParameters
+    from damage_dolfinx.problem import Problem
     from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
     p, rho, c_nu, k = 20.0, 1.0, 2e4, 0.01
     geometry = box(MPI.COMM_WORLD, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (n, n, n),
@@ -177,7 +177,7 @@ def test_dynamic_block_contact_force_balance(n):
                              q_star=1.0, L_trunc=1000.0, stop_at_zeta_star=False,
                              extra={"rho": rho, "m_visc": 10.0, "c_nu": c_nu, "gap": 0.0,
                                     "damage_active": False, "stability_check": "off"})
-    data = ProblemData("block", geometry, params.validate(), TimeGrid(k, 0.3),
+    data = Problem("3.1", geometry, 0.3, k=k, params=params.validate(), name="block",
                        traction=lambda x, t: ufl.as_vector((0.0, 0.0, -p)))
     st = DynamicKelvinVoigt(data)
     msh = st.mesh

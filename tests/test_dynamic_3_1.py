@@ -15,8 +15,8 @@ from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import B_plane_stress, eps
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
-from damage_dolfinx.parameters import InputError, TimeGrid
-from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
 
 COMM = MPI.COMM_WORLD
@@ -29,7 +29,7 @@ def free_square(k, T, traction=None, n=4):
                                                     L_trunc=math.inf)
     geo = rectangle(COMM, (0, 0), (6, 6), n, n, {
         GAMMA_D: lambda x: side(0, 0.0)(x) | side(0, 6.0)(x), GAMMA_N: side(1, 6.0)})
-    return DynamicKelvinVoigt(ProblemData("3.1-free", geo, params, TimeGrid(k, T),
+    return DynamicKelvinVoigt(Problem("3.1", geo, T, k=k, params=params, name="3.1-free",
                                           traction=traction))
 
 

@@ -15,8 +15,8 @@ def _block_stepper(f, g, rho, k=0.02, T=0.1, L=2.0, H=1.0):
     (f, 0), no damage source."""
     from damage_dolfinx.geometries import GAMMA_C
     from damage_dolfinx.geometries.rectangle import rectangle, side
-    from damage_dolfinx.parameters import ModelParameters, TimeGrid
-    from damage_dolfinx.models.base import ProblemData
+    from damage_dolfinx.parameters import ModelParameters
+    from damage_dolfinx.problem import Problem
     from damage_dolfinx.models.dynamic_tresca_3_2 import DynamicTresca
     geometry = rectangle(MPI.COMM_WORLD, (0, 0), (L, H), 8, 4, {GAMMA_C: side(1, 0.0)})
     params = ModelParameters(
@@ -24,7 +24,7 @@ def _block_stepper(f, g, rho, k=0.02, T=0.1, L=2.0, H=1.0):
         L_trunc=1000.0, stop_at_zeta_star=False,
         extra={"rho": rho, "m_visc": 100.0, "g_fric": g, "eps_reg": 1e-9,
                "friction_solver": "newton", "stability_check": "off"}).validate()
-    data = ProblemData("block", geometry, params, TimeGrid(k, T),
+    data = Problem("3.2", geometry, T, k=k, params=params, name="block",
                        body_force=lambda x, t: ufl.as_vector((f, 0.0)),
                        builders={"contact_faces": {"bottom": lambda X: np.isclose(X[1], 0.0)}})
     return DynamicTresca(data)

@@ -13,8 +13,8 @@ from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 from damage_dolfinx import compat
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
-from damage_dolfinx.parameters import ModelParameters, TimeGrid
-from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.fully_damageable_3_3 import FullyDamageableContact
 
 
@@ -34,7 +34,7 @@ def _square(n=4):
 
 
 def _data(params, k, T, geometry=None, traction=(0.0, -10.0), zeta0=1.0):
-    return ProblemData("3.3-test", geometry or _square(), params, TimeGrid(k, T),
+    return Problem("3.3", geometry or _square(), T, k=k, params=params, name="3.3-test",
                        traction=lambda x, t: ufl.as_vector((traction[0] * t, traction[1] * t)),
                        zeta0=zeta0)
 
@@ -133,7 +133,7 @@ def test_contact_impulse_scales_with_damage(zeta0):
     g0, c_nu, k = 1e-3, 1e4, 1e-3
     geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 4, 4, {GAMMA_C: side(1, 0.0)})
     params = _params(c_nu=c_nu, gap=-g0)
-    data = ProblemData("3.3-impulse", geo, params, TimeGrid(k, k), zeta0=zeta0)
+    data = Problem("3.3", geo, k, k=k, params=params, name="3.3-impulse", zeta0=zeta0)
     s = _run(FullyDamageableContact(data))
     momentum = compat.assemble_scalar(compat.form(s.v[1] * ufl.dx), s.comm)
     expected = k * zeta0 * c_nu * g0 * 1.0

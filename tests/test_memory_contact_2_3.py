@@ -9,8 +9,8 @@ from mpi4py import MPI
 from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
 from damage_dolfinx.geometries.rectangle import rectangle, side
-from damage_dolfinx.parameters import ModelParameters, TimeGrid
-from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.memory_2_3 import ViscoelasticMemoryContact
 
 
@@ -23,7 +23,7 @@ def pushed_block(c_nu, E=100.0, H=2.0, g0=0.01, n=4):
                                     "memory_amplitude": 0.0})
     geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, H), n, 2 * n,
                     {GAMMA_D: side(1, H), GAMMA_C: side(1, 0.0)})
-    stepper = ViscoelasticMemoryContact(ProblemData("nc-test", geo, params, TimeGrid(1.0, 1.0)))
+    stepper = ViscoelasticMemoryContact(Problem("2.3", geo, 1.0, k=1.0, params=params, name="nc-test"))
     stepper.initialize()
     X = stepper.u.function_space.tabulate_dof_coordinates()
     u = stepper.u.x.array.reshape(-1, 2)
@@ -117,7 +117,7 @@ def test_split_jacobian_equals_assembly():
                              extra={"c_nu": 1e3, "gap": 0.0, "memory_kernel": "constant"})
     geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 6, 6,
                     {GAMMA_D: side(1, 1.0), GAMMA_C: side(1, 0.0)})
-    s = ViscoelasticMemoryContact(ProblemData("split-test", geo, params, TimeGrid(1.0, 1.0)))
+    s = ViscoelasticMemoryContact(Problem("2.3", geo, 1.0, k=1.0, params=params, name="split-test"))
     V = s.u.function_space
     X = V.tabulate_dof_coordinates()
     s.u.x.array.reshape(-1, 2)[:, 1] = -0.01 * np.sin(7.0 * X[:, 0])  # contact where < 0

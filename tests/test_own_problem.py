@@ -114,7 +114,7 @@ def test_irreversible_damage_never_increases():
     heal = dd.DamageLaw(lambda e, z, p: 5.0 * (1.0 - z) - 50.0 * ufl.inner(e, e) * 1e4, "heal")
     for irreversible in (False, True):
         problem = rect_problem(damage_law=heal, irreversible=irreversible, zeta0=0.5)
-        stepper = problem.example().build(MPI.COMM_WORLD)
+        stepper = problem.checked().build(MPI.COMM_WORLD)
         stepper.initialize()
         rises = 0.0
         for _ in range(stepper.num_steps):
@@ -203,11 +203,11 @@ def test_a_chosen_k_above_k_max_is_refused(tmp_path):
 def test_default_k_divides_any_final_time():
     from damage_dolfinx.catalogue.examples import get
     ex = get("3.3-ex3")
-    _, grid, _, h, _ = ex.configure(h=0.3, T=0.5)
+    grid = ex.configure(h=0.3, T=0.5).time
     assert grid.num_steps * grid.k == pytest.approx(0.5, rel=1e-12) and grid.k <= ex.k
-    _, grid, _, _, _ = ex.configure(h=0.075, T=0.5)
+    grid = ex.configure(h=0.075, T=0.5).time
     assert grid.k <= ex.k * 0.5 * (1 + 1e-9)
-    _, grid, _, _, _ = ex.configure()
+    grid = ex.configure().time
     assert grid.k == ex.k  # the example's own k, bit for bit
 
 

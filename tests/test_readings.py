@@ -42,7 +42,7 @@ def test_reading_changes_only_what_it_lists():
 
 def test_reading_through_overrides_is_the_same_as_get():
     ex = examples.catalogue()["2.2-ex2"]
-    params, *_ = ex.configure(overrides={"reading": "literal", "kappa": "0.5"})
+    params = ex.configure(overrides={"reading": "literal", "kappa": "0.5"}).params
     assert params.kappa == 0.5
     assert examples.get("2.2-ex2", "literal").traction is not examples.get("2.2-ex2").traction
 

@@ -173,7 +173,7 @@ def test_viscoplastic_stepper_takes_the_dimension_from_the_mesh():
     from damage_dolfinx.catalogue import examples
     from damage_dolfinx.catalogue.section_3d_tresca import _unit_cube
     ex = dataclasses.replace(
-        examples.get("2.4-ex1", "literal"), dim=3, make_geometry=_unit_cube, literal=None,
+        examples.get("2.4-ex1", "literal"), dim=3, mesh=_unit_cube, literal=None,
         readings={}, reading=None,
         traction=lambda x, t: ufl.as_vector((50.0 * (ufl.exp(t) - 1.0), 0.0, 0.0)))
     s = ex.build(MPI.COMM_WORLD, n=4, k=0.02)

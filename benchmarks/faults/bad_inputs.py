@@ -55,7 +55,7 @@ def user_files(folder, names):
 def gmsh_mesh(path, kind):
     """A .msh file: 'ok' (unit square, cells tag 10, left edge 1, the others 2), 'notags'
     (no physical groups), 'tag1' (only the left edge tagged), '1d' (a line), '3d' (a cube)."""
-    from damage_dolfinx.runtime.runfolder import _gmsh
+    from damage_dolfinx.runtime.meshfile import _gmsh
     gmsh = _gmsh()  # the package's gmsh session (the tests run in one process)
     gmsh.model.add("m")
     occ = gmsh.model.occ

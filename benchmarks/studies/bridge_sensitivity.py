@@ -69,7 +69,7 @@ def collapse(h, k, overrides, geometry, comm, T=0.3):
     from damage_dolfinx.geometries.bridge import arch_bridge
     ex = examples.get("2.1-ex3")
     if geometry:
-        ex = dataclasses.replace(ex, make_geometry=lambda c, n, hh: arch_bridge(c, h=hh, **geometry))
+        ex = dataclasses.replace(ex, mesh=lambda c, n, hh: arch_bridge(c, h=hh, **geometry))
     overrides = {"load_rate": BASE["load_rate"], **overrides}
     start = time.perf_counter()
     stepper = ex.build(comm, h=h, k=k, T=T, overrides=overrides)

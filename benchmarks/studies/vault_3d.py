@@ -77,7 +77,7 @@ def stiffness(comm):
         ex = examples.get(ex_id)
         ex = dataclasses.replace(ex, params=dataclasses.replace(ex.params, nu=nu))
         if geometry:
-            ex = dataclasses.replace(ex, make_geometry=lambda c, n, hh: barrel_vault(
+            ex = dataclasses.replace(ex, mesh=lambda c, n, hh: barrel_vault(
                 c, h=hh, **geometry))
         stepper = ex.build(comm, h=h, k=0.001, T=0.001)
         stepper.initialize()

@@ -62,11 +62,11 @@ def examples():
         lam_D=2e-3, lam_u_plus=5e9, lam_u_minus=5e9, lam_w=7e-4, stop_at_zeta_star=False,
         extra=dict(BRIDGE_DEFAULTS, load_rate=LOAD_RATE, damage_bound="none"))
     ex3 = Example(
-        id="2.1-ex3", section="2.1", readings={"evidence": EVIDENCE}, default_reading="evidence",
+        name="2.1-ex3", section="2.1", readings={"evidence": EVIDENCE}, default_reading="evidence",
         title="masonry arch ring, self weight + quarter-span load P = load_rate t: collapse load "
               "and hinges",
         params=params, T=0.3, k=1e-3, h=0.05, diameter=2 * (RADIUS_CENTRE + THICKNESS / 2),
-        make_geometry=lambda comm, n, h: arch_bridge(comm, h=h),
+        mesh=lambda comm, n, h: arch_bridge(comm, h=h),
         model="2.1-collapse",
         assumptions=[
             "G3: semicircular ring, centre-line radius 15/pi = 4.775 m (centre line 15.0 m), "
@@ -134,10 +134,10 @@ def vault_example(ex3):
 
     from damage_dolfinx.geometries.vault import barrel_vault
     return replace(
-        ex3, id="2.1-ex3-vault", dim=3, h=VAULT_H,
+        ex3, name="2.1-ex3-vault", dim=3, h=VAULT_H,
         title=f"3-D: the arch ring extruded to a barrel vault {VAULT_WIDTH:g} m wide, line load "
               "P = load_rate t [kN/m] across the width at quarter span: collapse load, hinge lines",
-        make_geometry=lambda comm, n, h: barrel_vault(comm, h=h, **VAULT_GEOMETRY),
+        mesh=lambda comm, n, h: barrel_vault(comm, h=h, **VAULT_GEOMETRY),
         assumptions=[
             "beyond the thesis (which is plane stress): the ring of 2.1-ex3 (G3 "
             f"geometry, no fill) extruded along z by W = {VAULT_WIDTH:g} m; free end faces "

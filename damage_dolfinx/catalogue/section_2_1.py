@@ -23,11 +23,11 @@ def examples():
         "1.9/G37: von Mises = plane-stress value of eta_*(zeta) B eps(u), cell-wise (DG0)",
     ]
     ex1 = Example(
-        id="2.1-ex1", section="2.1",
+        name="2.1-ex1", section="2.1",
         title="square (0,5)^2 with clamped hole [2,3]^2, body force (50,25)t: convergence example",
         params=ModelParameters(**common, lam_u_plus=1000.0, lam_u_minus=100.0),
         T=1.0, k=0.01, n=20, diameter=5 * math.sqrt(2),
-        make_geometry=lambda comm, n, h: square_with_hole(comm, n),
+        mesh=lambda comm, n, h: square_with_hole(comm, n),
         model="2.1",
         body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t)),
         assumptions=common_assumptions + [
@@ -40,11 +40,11 @@ def examples():
 
     def ex2(letter, lam_plus, lam_minus, figure, kind):
         return Example(
-            id=f"2.1-ex2{letter}", section="2.1",
+            name=f"2.1-ex2{letter}", section="2.1",
             title=f"disc |x|<4 minus diamond, clockwise traction (5y,-5x)t: {kind} damage only",
             params=ModelParameters(**common, lam_u_plus=lam_plus, lam_u_minus=lam_minus),
             T=1.0, k=0.01, h=0.1, diameter=8.0,
-            make_geometry=lambda comm, n, h: disc_minus_diamond(comm, h=h, h_corner=h / 2),
+            mesh=lambda comm, n, h: disc_minus_diamond(comm, h=h, h_corner=h / 2),
             model="2.1",
             traction=lambda x, t: ufl.as_vector((5.0 * x[1] * t, -5.0 * x[0] * t)),
             assumptions=common_assumptions + [

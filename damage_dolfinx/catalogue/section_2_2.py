@@ -51,26 +51,26 @@ def examples():
         GAMMA_D: side(0, 0.0), GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)})
     layout = "G5: Gamma_D = {0}x[0,1], f_N on {1}x[0,1], top free, Gamma_C = [0,1]x{0}"
     test1 = dict(params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),  # Ex. 1-2
-                 make_geometry=square, model="2.2",
+                 mesh=square, model="2.2",
                  traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0)))
     ex1 = Example(
-        id="2.2-ex1", section="2.2", readings={"evidence": EVIDENCE}, default_reading="evidence",
+        name="2.2-ex1", section="2.2", readings={"evidence": EVIDENCE}, default_reading="evidence",
         title="unit square, traction (100,0)e^t, Tresca g = 5: friction algorithm comparison",
         **test1, assumptions=common + [layout],
         figures=[Figure("figure_2_10.png", "Example 2.2-1: setting and mesh", kind="mesh"),
                  Figure("fields_final.png", "Example 2.2-1: von Mises stress and damage")])
     ex2 = Example(
-        id="2.2-ex2", section="2.2", readings={"evidence": EVIDENCE}, default_reading="evidence",
+        name="2.2-ex2", section="2.2", readings={"evidence": EVIDENCE}, default_reading="evidence",
         title="Example 1 physics: convergence study (Table 2.4)",
         **test1, assumptions=common + [layout, "G10: nested structured meshes, diagonals right"],
         figures=[Figure("fields_final.png", "Example 2.2-2: von Mises stress and damage")],
         convergence=dict(ref_n=256, ref_k=5e-4, n=[8, 16, 32, 64, 128],
                          k=[0.02, 0.01, 0.005, 0.002, 0.001]))
     ex3 = Example(
-        id="2.2-ex3", section="2.2",
+        name="2.2-ex3", section="2.2",
         title="stick-slip: square (0,4)^2 between two frictional planes (g = 45 below, 1000 above)",
         params=_params(45.0), T=5.0, k=0.005, n=40, diameter=4 * math.sqrt(2),
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 4), n, n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (4, 4), n, n, {
             GAMMA_C: lambda x: side(1, 0.0)(x) | side(1, 4.0)(x)}),
         model="2.2",
         body_force=lambda x, t: ufl.as_vector((100.0 * ufl.sin(math.pi * t / 2.0), 0.0)),

@@ -33,10 +33,10 @@ def examples():
         "times compare",
     ]
     ex1 = Example(
-        id="2.3-ex1", section="2.3",
+        name="2.3-ex1", section="2.3",
         title="unit square on a normal-compliance foundation, traction (-10,-10): convergence",
         params=params(100.0, "constant"), T=1.0, k=0.01, n=16, diameter=2 ** 0.5,
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {
             GAMMA_D: side(0, 0.0), GAMMA_C: side(1, 0.0), GAMMA_N: side(0, 1.0)}),
         model="2.3",
         traction=lambda x, t: ufl.as_vector((-10.0, -10.0)),
@@ -47,10 +47,10 @@ def examples():
         convergence=dict(ref_n=256, ref_k=5e-4, n=[4, 8, 16, 32, 64, 128],
                          k=[0.05, 0.02, 0.01, 0.005, 0.002, 0.001]))
     ex2 = Example(
-        id="2.3-ex2", section="2.3",
+        name="2.3-ex2", section="2.3",
         title="block (0,3)x(0,2) pushed by (-30,0) against a foundation on {0}x[0,1]: memory relaxation",
         params=params(1000.0, "constant"), T=2.0, k=0.01, n=10, diameter=13 ** 0.5,
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (3, 2), 3 * n, 2 * n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (3, 2), 3 * n, 2 * n, {
             GAMMA_D: side(1, 0.0), GAMMA_C: side(0, 0.0, 0.0, 1.0), GAMMA_N: side(0, 3.0)}),
         model="2.3",
         traction=lambda x, t: ufl.as_vector((-30.0, 0.0)),
@@ -62,10 +62,10 @@ def examples():
                  Figure("figure_2_18.png", "Example 2.3-2: damage", fields=("zeta",),
                         amplification=3.0)])
     ex3 = Example(
-        id="2.3-ex3", section="2.3",
+        name="2.3-ex3", section="2.3",
         title="cantilever (0,4)x(0,1) on a foundation, load (0,-10) removed at t = 0.5, fading memory",
         params=params(1000.0, "exponential"), T=1.0, k=0.01, n=20, diameter=17 ** 0.5,
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 1), 4 * n, n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (4, 1), 4 * n, n, {
             GAMMA_D: side(0, 0.0), GAMMA_C: side(1, 0.0, 3.0, 4.0), GAMMA_N: side(1, 1.0)}),
         model="2.3",
         traction=lambda x, t: ufl.as_vector((0.0, ufl.conditional(ufl.le(t, 0.5 + 1e-12), -10.0, 0.0))),

@@ -56,11 +56,11 @@ def examples():
     square = lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {  # noqa: E731
         GAMMA_D: side(0, 0.0), GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)})
     ex1 = Example(
-        id="2.4-ex1", section="2.4", readings={"evidence": EVIDENCE_EX1},
+        name="2.4-ex1", section="2.4", readings={"evidence": EVIDENCE_EX1},
         title="unit square, traction (50,0)e^t, Tresca g = 0.7 (P1) or simplified Coulomb "
               "mu_f = 0.05, S_n = 10 (P2; --friction-law coulomb): convergence",
         params=_params(0.7), T=1.0, k=0.002, n=64, diameter=math.sqrt(2),
-        make_geometry=square, model="2.4",
+        mesh=square, model="2.4",
         traction=lambda x, t: ufl.as_vector((50.0 * ufl.exp(t), 0.0)),
         assumptions=common + [
             "Gamma_D = {0}x[0,1], f_N on {1}x(0,1), top free, Gamma_C = [0,1]x{0}",
@@ -73,10 +73,10 @@ def examples():
         convergence=dict(ref_n=256, ref_k=0.001, n=[8, 16, 32, 64, 128],
                          k=[0.02, 0.01, 0.005, 0.002]))
     ex2 = Example(
-        id="2.4-ex2", section="2.4",
+        name="2.4-ex2", section="2.4",
         title="unit square, no clamping, traction (55,0)e^t, Tresca bound g = 1000 never reached",
         params=_params(1000.0), T=1.0, k=0.002, n=64, diameter=math.sqrt(2),
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {
             GAMMA_N: side(0, 1.0), GAMMA_C: side(1, 0.0)}),
         model="2.4",
         traction=lambda x, t: ufl.as_vector((55.0 * ufl.exp(t), 0.0)),

@@ -71,12 +71,12 @@ def examples():
         "G43: no stop at zeta_star in Section 3.1",
     ]
     ex1 = Example(
-        id="3.1-ex1", section="3.1", readings={"evidence": EVIDENCE_EX1},
+        name="3.1-ex1", section="3.1", readings={"evidence": EVIDENCE_EX1},
         default_reading="evidence",
         title="square (0,6)^2 clamped at both sides, traction (20,-20)t on top, foundation below: "
               "convergence (Table 3.1)",
         params=_params(1000.0, 1.0, 1e-2, 2e4), T=1.0, k=0.01, n=16, diameter=6 * math.sqrt(2),
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (6, 6), n, n,
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (6, 6), n, n,
                                                    layout_example1()),
         model="3.1",
         traction=lambda x, t: ufl.as_vector((20.0 * t, -20.0 * t)),
@@ -95,11 +95,11 @@ def examples():
                          k=[0.05, 0.02, 0.01, 0.005, 0.002, 0.001]))
 
     ex2 = Example(
-        id="3.1-ex2", section="3.1",
+        name="3.1-ex2", section="3.1",
         title="beam (0,3)x(0,1) clamped at x = 0 on a deformable foundation, traction "
               "(4.5,-4.5) sin(2 pi t) on top, initially damaged centre",
         params=_params(100.0, 1.0, 1e-2, 2e4), T=1.0, k=0.004, n=30, diameter=math.sqrt(10),
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (3, 1), 3 * n, n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (3, 1), 3 * n, n, {
             GAMMA_D: side(0, 0.0), GAMMA_N: side(1, 1.0), GAMMA_C: side(1, 0.0)}),
         model="3.1",
         traction=lambda x, t: ufl.as_vector((4.5 * ufl.sin(2 * math.pi * t),
@@ -124,12 +124,12 @@ def examples():
                         amplification=4.0)])
 
     ex3 = Example(
-        id="3.1-ex3", section="3.1",
+        name="3.1-ex3", section="3.1",
         title="inverted L clamped at its foot, overhang on a deformable obstacle, traction "
               "(0,-7)|sin(pi t)| on top; --set damage_active=0 for the undamaged run",
         params=_params(1e4, 0.05, 5e-4, 2e5), T=10.5, k=0.001, h=1.0 / 32.0,
         diameter=2 * math.sqrt(2),
-        make_geometry=lambda comm, n, h: lshape(comm, h),
+        mesh=lambda comm, n, h: lshape(comm, h),
         model="3.1",
         traction=lambda x, t: ufl.as_vector((0.0, -7.0 * abs(ufl.sin(math.pi * t)))),
         assumptions=common + [

@@ -72,12 +72,12 @@ def examples():
     square = lambda comm, n, h: rectangle(comm, (0, 0), (1, 1), n, n, {  # noqa: E731
         GAMMA_D: side(0, 1.0), GAMMA_N: side(0, 0.0), GAMMA_C: side(1, 0.0)})
     ex1 = Example(
-        id="3.2-ex1", section="3.2", readings={"evidence": EVIDENCE_EX1},
+        name="3.2-ex1", section="3.2", readings={"evidence": EVIDENCE_EX1},
         default_reading="evidence",
         title="unit square, traction (200,0)(e^t - 1) on {0}x[0,1], Tresca g = 5: convergence "
               "(Table 3.2)",
         params=_params(5.0), T=1.0, k=0.01, n=16, diameter=math.sqrt(2),
-        make_geometry=square, model="3.2",
+        mesh=square, model="3.2",
         traction=lambda x, t: ufl.as_vector((200.0 * (ufl.exp(t) - 1.0), 0.0)),
         builders={"contact_faces": {"bottom": _on(1, 0.0)}},
         assumptions=common + [
@@ -92,11 +92,11 @@ def examples():
                          k=[0.02, 0.01, 0.005, 0.002, 0.001]))
 
     ex2 = Example(
-        id="3.2-ex2", section="3.2",
+        name="3.2-ex2", section="3.2",
         title="block (0,4)x(0,2) between two frictional planes (g = 1 above, 1000 below), "
               "f_B = (40,0) sin(1.5 pi t)",
         params=_params(1.0), T=3.0, k=0.005, n=20, diameter=math.hypot(4, 2),
-        make_geometry=lambda comm, n, h: rectangle(comm, (0, 0), (4, 2), 4 * n, 2 * n, {
+        mesh=lambda comm, n, h: rectangle(comm, (0, 0), (4, 2), 4 * n, 2 * n, {
             GAMMA_C: lambda x: side(1, 0.0)(x) | side(1, 2.0)(x)}),
         model="3.2",
         body_force=lambda x, t: ufl.as_vector((40.0 * ufl.sin(1.5 * math.pi * t), 0.0)),
@@ -123,10 +123,10 @@ def examples():
                                 ("u_tau_max_bottom", "max |u_tau| bottom (g = 1000) [m]")))])
 
     ex3 = Example(
-        id="3.2-ex3", section="3.2",
+        name="3.2-ex3", section="3.2",
         title="block on a 45-degree slope held by an obstacle, gravity 40(e^t - 1), Tresca g = 1",
         params=_params(1.0), T=1.0, k=0.005, n=20, diameter=math.hypot(2, 1),
-        make_geometry=lambda comm, n, h: slope_block(comm, n),
+        mesh=lambda comm, n, h: slope_block(comm, n),
         model="3.2",
         body_force=lambda x, t: -20.0 * math.sqrt(2) * (ufl.exp(t) - 1.0) * ufl.as_vector((1.0, 1.0)),
         builders={"contact_faces": {"plane": _on(1, 0.0), "obstacle": _on(0, 0.0)}},

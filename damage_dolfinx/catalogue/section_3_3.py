@@ -79,13 +79,13 @@ def examples():
         "(semismooth Newton, MUMPS), NOT the thesis scheme, for fast qualitative runs only",
     ]
     ex1 = Example(
-        id="3.3-ex1", section="3.3",
+        name="3.3-ex1", section="3.3",
         title="square (0,6)^2 clamped at both sides, traction (0,-10t) on top, foundation below: "
               "convergence (Table 3.3.3, Figure 3.16)",
         params=_params(100.0, 0.3, 2700.0, 2000.0, 2e3, 1.0, 1000.0, False,
                        stability_check="off"),
         T=1.0, k=0.01, n=16, diameter=6 * math.sqrt(2),
-        make_geometry=lambda comm, n, h: _square(comm, n),
+        mesh=lambda comm, n, h: _square(comm, n),
         model="3.3",
         traction=lambda x, t: ufl.as_vector((0.0, -10.0 * t)),
         assumptions=common + [
@@ -105,12 +105,12 @@ def examples():
                          k=[0.1, 0.02, 0.01, 0.005, 0.002, 0.001]))
 
     ex2 = Example(
-        id="3.3-ex2", section="3.3",
+        name="3.3-ex2", section="3.3",
         title="square (0,6)^2 as Ex. 1, traction (0,-2.5e8 t sin(pi t)), initially damaged centre "
               "(--set initial_damage=a) or bottom (b): healing inside, damage at the top corners",
         params=_params(7.1e9, 0.33, 2700.0, 100.0, 1e9, 1e6, math.inf, True, initial_damage="a"),
         T=7.5, k=K_EX2, n=16, diameter=6 * math.sqrt(2),
-        make_geometry=lambda comm, n, h: _square(comm, n),
+        mesh=lambda comm, n, h: _square(comm, n),
         model="3.3",
         traction=lambda x, t: ufl.as_vector((0.0, -2.5e8 * t * ufl.sin(math.pi * t))),
         builders={"zeta0": {"a": zeta0_centre, "b": zeta0_bottom}, "probe": (0.0, 6.0),
@@ -142,14 +142,14 @@ def examples():
                  Figure("fields_final.png", "Example 3.3-2: von Mises stress and damage")])
 
     ex3 = Example(
-        id="3.3-ex3", section="3.3",
+        name="3.3-ex3", section="3.3",
         title="ring wrench on a stiff hexagonal screw, cyclic pressure 1e5 sqrt(2)|sin(pi t)| "
               "on the end of the handle",
         params=_params(7.1e9, 0.33, 2700.0, 1.5e3, 1e9, 1e6, math.inf, False,
                        history_every=HISTORY_EVERY_EX3, damage_atol_rel=0.0,
                        damage_source_map=True),
         T=6.5, k=K_EX3, h=0.15, diameter=math.hypot(11.2, 2.4),
-        make_geometry=lambda comm, n, h: wrench(comm, h=h, h_contact=h / 3),
+        mesh=lambda comm, n, h: wrench(comm, h=h, h_contact=h / 3),
         model="3.3",
         traction=lambda x, t: ufl.as_vector((-1e5 * abs(ufl.sin(math.pi * t)),
                                              -1e5 * abs(ufl.sin(math.pi * t)))),

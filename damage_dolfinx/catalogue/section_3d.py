@@ -57,13 +57,13 @@ def examples():
     from damage_dolfinx.geometries.box_with_hole import box_with_hole
 
     ex1 = Example(
-        id="2.1-ex1-3d", section="2.1",
+        name="2.1-ex1-3d", section="2.1",
         title="3-D: cube (0,5)^3 with a clamped cavity [2,3]^3, body force (50,25,0)t",
         params=ModelParameters(E=1e4, nu=0.33, kappa=1.0, zeta_star=0.01, q_star=1000.0,
                                variant="B", lam_D=0.1, lam_w=0.0, stop_at_zeta_star=True,
                                lam_u_plus=1000.0, lam_u_minus=100.0),
         T=1.0, k=0.02, n=10, dim=3, diameter=5 * math.sqrt(3),
-        make_geometry=lambda comm, n, h: box_with_hole(comm, n),
+        mesh=lambda comm, n, h: box_with_hole(comm, n),
         model="2.1",
         body_force=lambda x, t: ufl.as_vector((50.0 * t, 25.0 * t, 0.0)),
         assumptions=[
@@ -100,11 +100,11 @@ def contact_examples():
         return [dataclasses.replace(f, title=title) for f in slices]
 
     ex23 = _from_2d(
-        _thesis_entry("section_2_3", "2.3-ex1"), id="2.3-ex1-3d",
+        _thesis_entry("section_2_3", "2.3-ex1"), name="2.3-ex1-3d",
         title="3-D: unit cube clamped at x = 0 on a normal-compliance foundation z = 0, "
               "traction (-10,0,-10) on x = 1",
         n=N_2_3_EX1, diameter=math.sqrt(3),
-        make_geometry=_box_geometry(1.0, N_2_3_EX1, {
+        mesh=_box_geometry(1.0, N_2_3_EX1, {
             GAMMA_D: face(0, 0.0), GAMMA_C: face(2, 0.0), GAMMA_N: face(0, 1.0)}),
         traction=lambda x, t: ufl.as_vector((-10.0, 0.0, -10.0)),
         assumptions=_3D_COMMON + [
@@ -120,11 +120,11 @@ def contact_examples():
         figures=figs("Example 2.3-1 in 3-D: von Mises stress and damage"))
     ex31_2d = _thesis_entry("section_3_1", "3.1-ex1")
     ex31 = _from_2d(
-        ex31_2d.literal or ex31_2d, id="3.1-ex1-3d", default_reading="literal",
+        ex31_2d.literal or ex31_2d, name="3.1-ex1-3d", default_reading="literal",
         title="3-D: cube (0,6)^3 clamped at x = 0 and x = 6, traction (20t,0,-20t) on top, "
               "normal-compliance foundation below (dynamic)",
         n=N_3_1_EX1, k=K_3_1_EX1, diameter=6 * math.sqrt(3),
-        make_geometry=_box_geometry(6.0, N_3_1_EX1, {
+        mesh=_box_geometry(6.0, N_3_1_EX1, {
             GAMMA_D: lambda x: face(0, 0.0)(x) | face(0, 6.0)(x), GAMMA_C: face(2, 0.0),
             GAMMA_N: face(2, 6.0)}),
         traction=lambda x, t: ufl.as_vector((20.0 * t, 0.0, -20.0 * t)),
@@ -143,12 +143,12 @@ def contact_examples():
             "SNES vinewtonrsls with CG + Jacobi (as in 2-D)"],
         figures=figs("Example 3.1-1 in 3-D: von Mises stress and damage"))
     ex33 = _from_2d(
-        _thesis_entry("section_3_3", "3.3-ex1"), id="3.3-ex1-3d",
+        _thesis_entry("section_3_3", "3.3-ex1"), name="3.3-ex1-3d",
         title="3-D: cube (0,6)^3 clamped at x = 0 and x = 6, traction (0,0,-10t) on top, fully "
               "damageable contact with a foundation below (dynamic)",
         n=N_3_3_EX1, diameter=6 * math.sqrt(3),
         params=_thesis_entry("section_3_3", "3.3-ex1").params.replace(stability_check="warn"),
-        make_geometry=_box_geometry(6.0, N_3_3_EX1, {
+        mesh=_box_geometry(6.0, N_3_3_EX1, {
             GAMMA_D: lambda x: face(0, 0.0)(x) | face(0, 6.0)(x), GAMMA_C: face(2, 0.0),
             GAMMA_N: face(2, 6.0)}),
         traction=lambda x, t: ufl.as_vector((0.0, 0.0, -10.0 * t)),
@@ -166,11 +166,11 @@ def contact_examples():
     from damage_dolfinx.geometries.wrench_plate import wrench_plate
     ex3_2d = _thesis_entry("section_3_3", "3.3-ex3")
     ex33w = _from_2d(
-        ex3_2d, id="3.3-ex3-3d",
+        ex3_2d, name="3.3-ex3-3d",
         title="3-D: the ring wrench as a plate of thickness 0.4 on a stiff hexagonal screw, "
               "cyclic pressure 1e5 sqrt(2)|sin(pi t)| on the end face of the handle",
         h=H_3_3_EX3, k=K_3_3_EX3, T=T_3_3_EX3, diameter=math.sqrt(11.2 ** 2 + 2.4 ** 2 + 0.4 ** 2),
-        make_geometry=lambda comm, n, h: wrench_plate(comm, h=h, h_contact=h / 2),
+        mesh=lambda comm, n, h: wrench_plate(comm, h=h, h_contact=h / 2),
         traction=lambda x, t: ufl.as_vector((-1e5 * abs(ufl.sin(math.pi * t)),
                                              -1e5 * abs(ufl.sin(math.pi * t)), 0.0)),
         assumptions=_3D_COMMON + [

@@ -75,10 +75,10 @@ def examples():
     e22 = _from_2d(
         _entry("section_2_2", "2.2-ex1"),
         lambda x, t: ufl.as_vector((100.0 * (ufl.exp(t) - 1.0), 0.0, 0.0)),
-        id="2.2-ex1-3d",
+        name="2.2-ex1-3d",
         title="3-D: unit cube clamped at x = 0, traction (100,0,0)e^t on x = 1, Tresca g = 5 "
               "on y = 0",
-        n=N_2_2_EX1, diameter=math.sqrt(3), make_geometry=_unit_cube,
+        n=N_2_2_EX1, diameter=math.sqrt(3), mesh=_unit_cube,
         traction=lambda x, t: ufl.as_vector((100.0 * ufl.exp(t), 0.0, 0.0)),
         assumptions=[
             "geometry: Gamma_D = {x = 0}, Gamma_N = {x = 1}, Gamma_C = {y = 0}; y = 1, z = 0, "
@@ -89,10 +89,10 @@ def examples():
         figures=[Figure("fields_slices.png", "Example 2.2-1 in 3-D: von Mises stress and damage",
                         kind="slices")])
     e32 = _from_2d(
-        _entry("section_3_2", "3.2-ex1"), id="3.2-ex1-3d",
+        _entry("section_3_2", "3.2-ex1"), name="3.2-ex1-3d",
         title="3-D: unit cube clamped at x = 1, traction (200,0,0)(e^t - 1) on x = 0, Tresca "
               "g = 5 on y = 0 (dynamic)",
-        n=N_3_2_EX1, diameter=math.sqrt(3), make_geometry=_cube_gamma_n_left,
+        n=N_3_2_EX1, diameter=math.sqrt(3), mesh=_cube_gamma_n_left,
         traction=lambda x, t: ufl.as_vector((200.0 * (ufl.exp(t) - 1.0), 0.0, 0.0)),
         assumptions=[
             "geometry: Gamma_D = {x = 1}, Gamma_N = {x = 0}, Gamma_C = {y = 0}; y = 1, z = 0, "

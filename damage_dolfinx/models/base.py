@@ -11,16 +11,22 @@ about it anywhere:
 * :meth:`Model.defaults` (typed default data) and :meth:`Model.check` (their validation);
 * ``checkpoint_fields``: the attributes (Functions) that a checkpoint holds;
 * ``history_columns``: the scalars it adds to history.csv (every one must be written);
-* :meth:`Model.sub_steps`: its sub-steps, each a solver object with its kind and PETSc prefix;
+* ``old_state`` (the (Function, copy) pairs a step starts from) and ``update`` (the explicit
+  update after the sub-steps, e.g. u_n = u_{n-1} + k v_n);
+* :meth:`Model.scheme`: its sub-steps in order (:class:`SubStep`: name, solver kind, PETSc
+  prefix, solve callable, the history keys of its iteration count);
 * in its constructor the unknowns (``self.u``, ``self.zeta``, ...) and ``self.output_fields``.
 
-One generic time loop (``runtime/runner.py``, or :func:`damage_dolfinx.steps`) runs any model:
-:meth:`Model.initialize` (t = 0), then :meth:`Model.advance` per step. A model implements
-``_advance()`` (t_{n-1} -> t_n, returning its solver counts) and ``update_output()``; its
-initial state is the shared one (zeta_0, u_0 = v_0 = 0) plus :meth:`Model.start`.
+One generic time loop (``runtime/loop.py``, or :func:`damage_dolfinx.steps`) runs any model:
+:meth:`Model.initialize` (t = 0), then :meth:`Model.advance` per step, which is the same for
+every model: copy the old state, run the sub-steps in order (timed, their counts collected),
+apply the explicit update. A scheme that needs more has two hooks, :meth:`Model.begin_step` and
+:meth:`Model.end_step`, and says why in its docstring. The initial state is the shared one
+(zeta_0, u_0 = v_0 = 0) plus :meth:`Model.start`; a model implements ``update_output()``.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -46,31 +52,18 @@ DAMAGE_A = dict(kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.
 LoadBuilder = Callable[[object, object], object]
 
 
-@dataclass
-class ProblemData:
-    """What a model is built from: the run's geometry (mesh and facet tags), data, time grid,
-    loads, initial damage, damage law and model-specific builders."""
-    example_id: str
-    geometry: object
-    params: ModelParameters
-    time: TimeGrid
-    body_force: Optional[LoadBuilder] = None
-    traction: Optional[LoadBuilder] = None
-    zeta0: Union[float, Callable] = 1.0
-    builders: dict = field(default_factory=dict)  # problem-specific UFL builders, e.g. g(x)
-    damage_law: Optional[object] = None  # laws.DamageLaw (None: the thesis law of params.variant)
-    irreversible: bool = False           # zeta_n <= zeta_{n-1} (the damage step's upper bound)
-
-
 @dataclass(frozen=True)
 class SubStep:
-    """One sub-step of a scheme: its name, the solver object (with ``solve()``), the kind of
-    solve (``linear``, ``snes-vi`` with bounds, ``newton`` on a regularised law, ``semismooth``
-    Newton, ``update`` for an explicit formula) and its PETSc options prefix."""
+    """One sub-step of a scheme: its ``name`` (its wall time goes to ``timings[name]``), the
+    ``kind`` of solve (``linear``, ``snes-vi`` with bounds, ``newton`` on a regularised law,
+    ``semismooth`` Newton, ``update`` for an explicit formula), its PETSc options ``prefix``, the
+    ``solve`` callable (no argument; returns its iteration count, or None; None: the sub-step is
+    switched off and counts 0 iterations), and ``its``: the history keys its count goes under."""
     name: str
-    solver: object
     kind: str
-    prefix: str = ""
+    prefix: str
+    solve: Optional[Callable[[], Optional[int]]]
+    its: tuple = ()
 
 
 class Model:
@@ -78,9 +71,8 @@ class Model:
     scalars.
 
     Subclasses create ``self.u`` (displacement), ``self.zeta`` and ``self.zeta_old`` (damage)
-    and ``self.von_mises`` (DG0), implement ``_advance()`` (one step t_{n-1} -> t_n, returning
-    a dict of iteration counts) and ``update_output()``, and list output fields in
-    ``self.output_fields``. Hooks for problem-specific output: ``history_columns`` (keys that
+    and ``self.von_mises`` (DG0), declare :meth:`scheme` (the sub-steps), implement
+    ``update_output()``, and list output fields in ``self.output_fields``. Hooks for problem-specific output: ``history_columns`` (keys that
     ``scalars()`` or the step stats add to history.csv; an instance may set
     ``extra_history_columns`` when they depend on the data) and ``summary_extra()`` (keys added
     to summary.json).
@@ -102,8 +94,11 @@ class Model:
     checkpoint_fields: tuple = ("u", "zeta")
     #: the scalars this model adds to history.csv
     history_columns: tuple = ()
-    #: the sub-steps in order: (attribute holding the solver, kind, PETSc options prefix)
-    scheme: tuple = ()
+    #: the old state a step starts from: (Function, its copy) attribute pairs, copied first
+    old_state: tuple = (("u", "u_old"), ("zeta", "zeta_old"))
+    #: the explicit update after the sub-steps, (new, old, rate): new = old + k rate
+    #: (e.g. ("u", "u_old", "v"): u_n = u_{n-1} + k v_n); None: none
+    update: Optional[tuple] = None
     #: quadrature degree of the contact integrals (None: estimated from the integrand); the
     #: contact resultant uses the scheme's, so that it balances the load exactly
     contact_quadrature_degree: Optional[int] = None
@@ -146,19 +141,23 @@ class Model:
     def extra_history_columns(self, columns):
         self._history_columns = list(columns)
 
-    def sub_steps(self) -> list:
-        """The scheme's sub-steps in order (:class:`SubStep`), from ``scheme``."""
-        return [SubStep(name, getattr(self, name), kind, prefix)
-                for name, kind, prefix in self.scheme if getattr(self, name, None) is not None]
+    def scheme(self) -> tuple:
+        """The scheme's sub-steps in order (:class:`SubStep`), each with its solve callable;
+        asked once, at the first step (the model is complete then)."""
+        return ()
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data):
+        if not isinstance(data.params, ModelParameters):  # a Problem built by hand
+            data = dataclasses.replace(data, params=data.parameters())
         self.data, self.params = data, data.params
         self.mesh = data.geometry.mesh
         self.comm = self.mesh.comm
-        self.context = SolveContext(example=data.example_id)
+        self.context = SolveContext(example=data.id)
         self.n, self.t = 0, 0.0
         self.t_const = fem.Constant(self.mesh, 0.0)
         self.output_fields = []
+        self.timings = {}  # seconds per sub-step, whole run
+        self._plan = None
 
     @property
     def error_components(self) -> list:
@@ -202,8 +201,50 @@ class Model:
         return {}
 
     def advance(self) -> dict:
+        """One step t_{n-1} -> t_n, the same for every model: :meth:`begin_step`, the old state
+        copied (``old_state``), the sub-steps of ``scheme`` in order (each timed into
+        ``timings[name]``, its iteration count under its ``its`` keys), the explicit update
+        (``update``), then :meth:`end_step`. Returns the iteration counts."""
         self._set_time(self.n + 1)
-        return self._advance()
+        if self._plan is None:
+            self._plan = self._step_plan()
+        copies, steps, update = self._plan
+        self.begin_step()
+        for new, old in copies:
+            old[:] = new
+        stats, timings, clock = {}, self.timings, time.perf_counter
+        for name, solve, keys in steps:
+            if solve is None:
+                its = 0
+            else:
+                start = clock()
+                its = solve()
+                timings[name] += clock() - start
+            for key in keys:
+                stats[key] = its
+        if update is not None:
+            new, old, rate = update
+            np.add(old, self.data.time.k * rate, out=new)
+        self.end_step(stats)
+        return stats
+
+    def _step_plan(self):
+        """The arrays and callables of :meth:`advance`, looked up once (the Functions' value
+        arrays are views that stay valid)."""
+        array = lambda name: getattr(self, name).x.array  # noqa: E731
+        copies = [(array(new), array(old)) for new, old in self.old_state]
+        steps = []
+        for s in self.scheme():
+            self.timings.setdefault(s.name, 0.0)
+            steps.append((s.name, s.solve, tuple(s.its)))
+        update = tuple(array(name) for name in self.update) if self.update else None
+        return copies, steps, update
+
+    def begin_step(self):
+        """What a scheme does before the old state is copied (none by default)."""
+
+    def end_step(self, stats: dict):
+        """What a scheme does after its explicit update (none by default)."""
 
     def _set_time(self, n):
         self.n, self.t = n, self.data.time.t(n)
@@ -283,14 +324,16 @@ class Model:
         if not hasattr(self, "_norm_operators"):
             self._norm_operators = self._assemble_norm_operators()
         M, K, m, area, y = self._norm_operators
-        u = compat.petsc_vec(self.u)
+        u, dot = compat.petsc_vec(self.u), bookkeeping.local_dot  # this rank's part
         M.mult(u, y)
-        u_L2_sq = u.dot(y)
+        parts = [dot(u, y)]
         K.mult(u, y)
-        eps_sq = u.dot(y)
-        zeta_integral = m.dot(compat.petsc_vec(self.zeta))
+        parts += [dot(u, y), dot(m, compat.petsc_vec(self.zeta))]
         owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
-        (zeta_min,), (zeta_max,) = bookkeeping.extrema(self.comm, [owned], [owned])
+        lo, hi = (owned.min(), owned.max()) if owned.size else (np.inf, -np.inf)
+        (u_L2_sq, eps_sq, zeta_integral), (neg_min, zeta_max) = \
+            bookkeeping.sums_and_maxima(self.comm, parts, [-lo, hi])  # one reduction
+        zeta_min = -neg_min
         return {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
                 "zeta_min": zeta_min, "zeta_max": zeta_max,
                 "zeta_mean": float(zeta_integral / area)}
@@ -354,7 +397,3 @@ class Model:
                 V = f.function_space
                 info[f"dofs_{name}"] = V.dofmap.index_map.size_global * V.dofmap.index_map_bs
         return info
-
-
-#: the former name of :class:`Model`
-TimeStepper = Model

@@ -28,6 +28,11 @@ with the consistent mass matrix it leaves checkerboard oscillations in the damag
 "none" is the literal linear step (2.20). The damage figures are drawn on [zeta_star, 1]
 (figstyle; a field that leaves it widens the scale and prints its extremes).
 
+The step is 2.1's, the package's generic one (models/base.py), with the damage sub-step of
+``damage_bound``; the failure record (the first failed section, the hinges, the running minimum
+of zeta) is kept after each step by ``scalars`` and ``stop_reason``, not inside the step, and is
+not checkpointed (``checkpoint_supported`` is False).
+
 Hinges and the mechanism: bridge_sections.py (section damage D_j, its peaks, the rotation of
 each cross-section and which hinges move at collapse).
 
@@ -57,7 +62,7 @@ from damage_dolfinx.numerics.constitutive import eps
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.geometries import GAMMA_N
 from damage_dolfinx.parameters import InputError, ModelParameters
-from damage_dolfinx.models.base import ProblemData
+from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.bridge_sections import RingSections
 from damage_dolfinx.models.elastic_2_1 import ElasticDamage
 
@@ -140,7 +145,7 @@ class BridgeDamage(RingSections, ElasticDamage):
         check_bridge_parameters(params.extra)
         return params
 
-    def __init__(self, data: ProblemData, **kwargs):
+    def __init__(self, data: Problem, **kwargs):
         geo = data.geometry
         if not hasattr(geo, "section_index"):
             raise InputError("example 2.1-ex3 needs the arch geometry (geometries/bridge.py); "

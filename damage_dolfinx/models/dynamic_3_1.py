@@ -25,6 +25,8 @@ contact forces, stability.py; docs/models.md, "Stability of the explicit terms")
 """
 from __future__ import annotations
 
+from functools import partial
+
 import time
 
 import numpy as np
@@ -41,7 +43,8 @@ from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
 
@@ -63,7 +66,8 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
     stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("v_L2", "u_max", "penetration_rms")
-    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # damage, (3.48)
+    old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
+    update = ("u", "u_old", "v")  # (3.51) u_n = u_{n-1} + k v_n
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -72,7 +76,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
                                       "damage_active": True, "stability_check": "error",
                                       "error_norm": "velocity"})
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -128,16 +132,17 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         self._contact_setup(ds(GAMMA_C))
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises, self.von_mises_strain]
         self.timings = {"damage": 0.0, "velocity": 0.0, "stability": self.stability.get("time_s", 0.0)}
+        self._prefixes = damage_prefix, mech_prefix
 
     # -- the scheme
-    def _advance(self) -> dict:
-        self.u_old.x.array[:] = self.u.x.array
-        self.v_old.x.array[:] = self.v.x.array
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        damage_its = self._timed("damage", self.damage.solve) if self.damage else 0  # (3.49)
-        mech_its = self._timed("velocity", self.mech.solve, self.v)                   # (3.48)
-        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array            # (3.51)
-        return {"damage_its": damage_its, "mech_its": mech_its}
+    def scheme(self) -> tuple:
+        """The damage step (3.49) (none when ``damage_active`` is off: 0 iterations), then the
+        velocity (3.48), a linear solve with a constant matrix."""
+        damage_prefix, mech_prefix = self._prefixes
+        return (SubStep("damage", "snes-vi", damage_prefix,                        # (3.49)
+                        self.damage.solve if self.damage else None, its=("damage_its",)),
+                SubStep("velocity", "linear", mech_prefix, partial(self.mech.solve, self.v),
+                        its=("mech_its",)))                                          # (3.48)
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
@@ -155,7 +160,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         out = estimate_stability(V, self.params.E, self.params.nu, self.rho, self.m_visc,
                                  c_nu=self.c_nu if self.has_contact else 0.0, dsC=dsC,
                                  bcs=self.bcs, normal=self.n_facet, k=self.k)
-        where = f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate"
+        where = f"{self.data.id}: explicit elastic and contact forces, eigenvalue estimate"
         checked(out, self.k, where, action)
         out["time_s"] = time.perf_counter() - start
         return out
@@ -173,6 +178,10 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         owned = self.u.function_space.dofmap.index_map.size_local
         d = self.mesh.topology.dim
         return bookkeeping.max_node_norm(self.u.x.array[:owned * d], d, self.comm)
+
+    def track(self):
+        """Between history rows (--history-every): nothing to do, scalars() keeps no running
+        values (the run's state check still runs every step)."""
 
     def scalars(self) -> dict:
         out = super().scalars()

@@ -17,7 +17,6 @@ Convergence errors use the norm (3.109): ||u||_L2 + ||zeta||_L2.
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import ufl
@@ -33,7 +32,8 @@ from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_form
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import checked, estimate_stability
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -41,7 +41,7 @@ from damage_dolfinx.parameters import ModelParameters
 class DynamicTresca(Model):
     """Problem VP^{hk} of Section 3.2.
 
-    Builders (ProblemData.builders): ``friction_bound`` (x -> UFL g(x), default the constant
+    Builders (Problem.builders): ``friction_bound`` (x -> UFL g(x), default the constant
     ``g_fric``) and ``contact_faces`` ({name: marker x -> bool}): for each face the history gets
     ``u_tau_max_<name>``, the largest |u_tau| over its contact nodes (nodal values).
     """
@@ -53,7 +53,8 @@ class DynamicTresca(Model):
     stability_limit = "explicit elastic force (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face
-    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))
+    old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
+    update = ("u", "u_old", "v")  # (3.96) u_n = u_{n-1} + k v_n
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -61,7 +62,7 @@ class DynamicTresca(Model):
                                extra={"rho": 1.0, "m_visc": 100.0, "g_fric": 5.0,
                                       "stability_check": "error", **FRICTION_DEFAULTS})
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data: Problem):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -94,7 +95,7 @@ class DynamicTresca(Model):
         self.friction_problem = FrictionProblem(self.v, a, l, self.bcs, g, ds(GAMMA_C),
                                                 self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.example_id)
+                                               data.id)
         self._faces_setup(data.builders.get("contact_faces") or {})
         self.k_max = self._stability_check(V, x)
 
@@ -107,18 +108,11 @@ class DynamicTresca(Model):
         self.timings = {"damage": 0.0, "friction": 0.0}
 
     # -- the scheme
-    def _advance(self) -> dict:
-        self.u_old.x.array[:] = self.u.x.array
-        self.v_old.x.array[:] = self.v.x.array
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        start = time.perf_counter()
-        damage_its = self.damage.solve()                                     # (3.94)
-        middle = time.perf_counter()
-        friction_its = self.friction.solve()                                 # (3.95) from v_{n-1}
-        self.timings["damage"] += middle - start
-        self.timings["friction"] += time.perf_counter() - middle
-        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array     # (3.96)
-        return {"damage_its": damage_its, "snes_its": friction_its, "friction_its": friction_its}
+    def scheme(self) -> tuple:
+        return (SubStep("damage", "snes-vi", "damage_", self.damage.solve,         # (3.94)
+                        its=("damage_its",)),
+                SubStep("friction", "newton", "friction_", self.friction.solve,    # (3.95)
+                        its=("snes_its", "friction_its")))
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
@@ -134,7 +128,7 @@ class DynamicTresca(Model):
         p = self.params  # Tresca adds no explicit stiffness: c_nu = 0; eta_* Phi_L only lowers B
         out = estimate_stability(V, p.E, p.nu, float(x["rho"]), float(x["m_visc"]), c_nu=0.0,
                                  bcs=self.bcs, k=self.k)
-        where = f"{self.data.example_id}: explicit elastic force, eigenvalue estimate"
+        where = f"{self.data.id}: explicit elastic force, eigenvalue estimate"
         checked(out, self.k, where, action)
         self.k_max_lower_bound = out.get("k_max_lower_bound")
         return None if out["k_max"] is None else float(out["k_max"])

@@ -17,8 +17,6 @@ Solver prefixes: ``damage_`` (damage PDE) and ``mech_`` (elasticity).
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import ufl
 from dolfinx import fem
@@ -34,7 +32,8 @@ from damage_dolfinx.numerics.solvers import LinearSolver, lagged_direct
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
-from damage_dolfinx.models.base import Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import Model, SubStep
 from damage_dolfinx.parameters import ModelParameters
 
 
@@ -46,7 +45,7 @@ class ElasticDamage(Model):
     contact_roles = ("bilateral",)
     #: u, zeta and the lagged preconditioner's damage (see checkpoint_state)
     checkpoint_fields = ("u", "zeta", "zeta_pc")
-    scheme = (("damage", "linear", "damage_"), ("mech", "linear", "mech_"))   # (2.20), (2.21)
+    old_state = (("zeta", "zeta_old"),)  # u_{n-1} stays in u until (2.21) replaces it
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -54,7 +53,7 @@ class ElasticDamage(Model):
                                variant="B", lam_D=0.1, lam_w=0.0, lam_u_plus=1000.0,
                                lam_u_minus=100.0, stop_at_zeta_star=True)
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh = self.params, self.mesh
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -98,29 +97,28 @@ class ElasticDamage(Model):
         self._vm_expr = compat.expression(
             von_mises(stress(self.u, self.zeta, p.E, p.nu, p.zeta_star)), Q)
         self.output_fields = [self.u, self.zeta, self.von_mises]
-        self.timings = {"damage": 0.0, "mech": 0.0}  # seconds per sub-step, whole run
+        self.timings = {"damage": 0.0, "mech": 0.0}
+        self._prefixes = damage_prefix, mech_prefix
+
+    def scheme(self) -> tuple:
+        damage_prefix, mech_prefix = self._prefixes
+        return (SubStep("damage", "linear", damage_prefix, self.damage.solve,   # (2.20)
+                        its=("damage_its",)),
+                SubStep("mech", "linear", mech_prefix, self._solve_mech,        # (2.21)
+                        its=("mech_its",)))
 
     def start(self) -> dict:
-        its = self._solve_mech()  # u_0 with zeta_0
+        its = self._timed("mech", self._solve_mech)  # u_0 with zeta_0
         self.update_output()
         return {"mech_its": its}
 
-    def _advance(self) -> dict:
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        start = time.perf_counter()
-        damage_its = self.damage.solve()
-        self.timings["damage"] += time.perf_counter() - start
-        mech_its = self._solve_mech()
-        return {"damage_its": damage_its, "mech_its": mech_its}
-
     def _solve_mech(self) -> int:
-        start = time.perf_counter()
+        """(2.21) by the lagged factorisation, recording the damage it was built from."""
         factorizations = self.mech.factorizations
         its = self.mech.solve(self.u)
         if self.mech.lagged and self.mech.factorizations != factorizations:
             self.zeta_pc.x.array[:] = self.zeta.x.array
         self._pc_due[0] = float(not self.mech.lagged or its > self.mech.refactor_after_its)
-        self.timings["mech"] += time.perf_counter() - start
         return its
 
     def checkpoint_state(self) -> dict:

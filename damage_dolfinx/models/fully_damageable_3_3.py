@@ -23,6 +23,11 @@ forces, stability.py; docs/models.md, "Stability of the explicit terms"), ``elas
 forces at u_{n-1} + k v_n, a semismooth Newton solve per step, prefix ``mech_``),
 ``initial_damage`` (a key of ``builders["zeta0"]``, Example 2's cases a/b).
 
+The step is the generic one (models/base.py) with two hooks, where this scheme is special:
+``begin_step`` starts the CG of (2) from the cubic extrapolation of v_{n-1}, ..., v_{n-4}
+(taken before the old state is copied, and shifted), and ``end_step`` samples the damage
+profiles of Example 2.
+
 Output: von Mises of the total stress zeta_n A eps(v_n) + zeta_n Phi_L(B eps(u_n)) (DG0);
 history columns v_L2, the maximal interpenetration (u.nu - gap)_+ over the Gamma_C vertices and
 its location, and zeta at ``builders["probe"]``; damage profiles along x_2 =
@@ -51,7 +56,8 @@ from damage_dolfinx.parameters import InputError, ModelParameters
 from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
 from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
 from damage_dolfinx.numerics.zeta_linear import VelocitySolver
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 
 #: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
 #: VELOCITY_EXTRAPOLATION);
@@ -80,7 +86,8 @@ class FullyDamageableContact(Model):
     stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("v_L2",)  # + the contact monitor's and the probe's columns
-    scheme = (("damage", "snes-vi", "damage_"), ("mech", "linear", "mech_"))  # (3.158), (3.159)
+    old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
+    update = ("u", "u_old", "v")  # (3.160) u_n = u_{n-1} + k v_n
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -89,7 +96,7 @@ class FullyDamageableContact(Model):
                                       "damage_active": True, "stability_check": "error",
                                       "elastic_term": "explicit"})
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -176,37 +183,45 @@ class FullyDamageableContact(Model):
         self.extra_history_columns = (["v_L2"] + self.contact.columns + self.probe.columns)
         self.timings = {"damage": 0.0, "velocity": 0.0,
                         "stability": self.stability.get("time_s", 0.0)}
+        self._prefixes = damage_prefix, mech_prefix
+        self._v_guess = None
 
     # -- the scheme
     def start(self) -> dict:
         self.profiles.sample(self.zeta, self.t)
         return {}
 
-    def _advance(self) -> dict:
-        if not hasattr(self, "_arrays"):  # views of the Functions' values (stable)
-            self._arrays = [f.x.array for f in (self.u, self.u_old, self.v, self.v_old,
-                                                self.zeta, self.zeta_old, *self._v_older)]
-        u, u_old, v, v_old, zeta, zeta_old, v3, v4 = self._arrays
-        extrapolate = self.extrapolate and self.elastic_term == "explicit"
-        if extrapolate:  # CG start: cubic extrapolation from v_{n-1}, ..., v_{n-4}
-            v_guess = 4.0 * (v + v3) - 6.0 * v_old - v4
-            v4[:] = v3
-            v3[:] = v_old
-        u_old[:] = u
-        v_old[:] = v
-        zeta_old[:] = zeta
-        damage_its = self._timed("damage", self.damage.solve) if self.damage else 0  # (3.158)
+    def scheme(self) -> tuple:
+        """(3.158) (none when ``damage_active`` is off: 0 iterations), then (3.159): by CG from
+        the extrapolated start (``explicit``, the thesis), or semismooth Newton (``implicit``)."""
+        damage_prefix, mech_prefix = self._prefixes
+        damage = SubStep("damage", "snes-vi", damage_prefix,                       # (3.158)
+                         self.damage.solve if self.damage else None, its=("damage_its",))
         if self.elastic_term == "explicit":
-            if extrapolate:
-                v[:] = v_guess
-            mech_its = self._timed("velocity", self.mech.solve, self.v)            # (3.159)
-            stats = {"damage_its": damage_its, "mech_its": mech_its}
-        else:
-            snes_its = self._timed("velocity", self.mech.solve)                     # implicit
-            stats = {"damage_its": damage_its, "snes_its": snes_its}
-        np.add(u_old, self.k * v, out=u)                                          # (3.160)
+            return damage, SubStep("velocity", "linear", mech_prefix, self._velocity,
+                                   its=("mech_its",))                                # (3.159)
+        return damage, SubStep("velocity", "semismooth", mech_prefix, self.mech.solve,
+                               its=("snes_its",))                                    # implicit
+
+    def begin_step(self):
+        """The CG start of (3.159): 4 v_{n-1} - 6 v_{n-2} + 4 v_{n-3} - v_{n-4}, from the
+        velocities before the old state is copied; v_{n-3}, v_{n-4} move on."""
+        if not (self.extrapolate and self.elastic_term == "explicit"):
+            return
+        if not hasattr(self, "_arrays"):  # views of the Functions' values (stable)
+            self._arrays = [f.x.array for f in (self.v, self.v_old, *self._v_older)]
+        v, v_old, v3, v4 = self._arrays
+        self._v_guess = 4.0 * (v + v3) - 6.0 * v_old - v4
+        v4[:] = v3
+        v3[:] = v_old
+
+    def _velocity(self) -> int:
+        if self._v_guess is not None:
+            self.v.x.array[:] = self._v_guess
+        return self.mech.solve(self.v)
+
+    def end_step(self, stats: dict):
         self.profiles.sample(self.zeta, self.t)
-        return stats
 
     def checkpoint_state(self) -> dict:
         """u, zeta, v and, for the CG start's extrapolation, v_{n-2}, v_{n-3}, v_{n-4}: without
@@ -266,14 +281,14 @@ class FullyDamageableContact(Model):
                                  c_nu=self.c_nu if has_contact else 0.0, dsC=dsC, bcs=self.bcs,
                                  normal=self.n_facet, k=self.k)
         checked(out, self.k,
-                f"{self.data.example_id}: explicit elastic and contact forces, eigenvalue estimate",
+                f"{self.data.id}: explicit elastic and contact forces, eigenvalue estimate",
                 action=action if self.elastic_term == "explicit" else "off")
         out["time_s"] = time.perf_counter() - start
         return out
 
     # -- scalars and summary
     def scalars(self) -> dict:
-        """The base scalars (the same operations as TimeStepper.scalars, so the same values)
+        """The base scalars (the same operations as Model.scalars, so the same values)
         plus v_L2, the interpenetration and the probe. The runner asks for them after every
         step (history.csv), so the vectors and views are cached and the extrema take one
         Allreduce, none in serial (120 -> 40 us per wrench step)."""

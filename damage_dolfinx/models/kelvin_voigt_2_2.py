@@ -16,8 +16,6 @@ Step (2) by one of the three friction solvers (damage_dolfinx/numerics/friction/
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import ufl
 from dolfinx import fem
@@ -31,7 +29,8 @@ from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -44,7 +43,8 @@ class KelvinVoigtTresca(Model):
     contact_roles = ("tresca",)
     stability_limit = "explicit elastic term: k <= 2/m_visc"
     checkpoint_fields = ("u", "zeta", "v")
-    scheme = (("damage", "snes-vi", "damage_"), ("friction", "newton", "friction_"))  # (1), (2.67)
+    old_state = (("u", "u_old"), ("zeta", "zeta_old"))
+    update = ("u", "u_old", "v")  # (2.68) u_n = u_{n-1} + k v_n
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -58,7 +58,7 @@ class KelvinVoigtTresca(Model):
         stable iff k m_visc zeta <= 2, so k_max = 2/m_visc (zeta <= 1)."""
         return 2.0 / float(params.extra["m_visc"])
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data: Problem):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -82,7 +82,7 @@ class KelvinVoigtTresca(Model):
         g = g_builder(ufl.SpatialCoordinate(msh)) if g_builder else fem.Constant(msh, x["g_fric"])
         self.friction_problem = FrictionProblem(self.v, a, l, bcs, g, ds(GAMMA_C), self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.example_id)
+                                               data.id)
         self._probe_setup(data.builders.get("probe"), ufl.action(a, self.v) - l)
 
         Q = compat.scalar_dg0(msh)
@@ -92,18 +92,11 @@ class KelvinVoigtTresca(Model):
         self.output_fields = [self.u, self.v, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "friction": 0.0}
 
-    # -- the scheme
-    def _advance(self) -> dict:
-        self.u_old.x.array[:] = self.u.x.array
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        start = time.perf_counter()
-        damage_its = self.damage.solve()
-        middle = time.perf_counter()
-        friction_its = self.friction.solve()
-        self.timings["damage"] += middle - start
-        self.timings["friction"] += time.perf_counter() - middle
-        self.u.x.array[:] = self.u_old.x.array + self.k * self.v.x.array
-        return {"damage_its": damage_its, "snes_its": friction_its}
+    def scheme(self) -> tuple:
+        return (SubStep("damage", "snes-vi", "damage_", self.damage.solve,       # (1)
+                        its=("damage_its",)),
+                SubStep("friction", "newton", "friction_", self.friction.solve,  # (2.67)
+                        its=("snes_its",)))
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)

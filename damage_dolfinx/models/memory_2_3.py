@@ -16,6 +16,8 @@ and exponential kernels (memory.py).
 """
 from __future__ import annotations
 
+from functools import partial
+
 
 import numpy as np
 import ufl
@@ -34,7 +36,8 @@ from damage_dolfinx.numerics.memory import MemoryKernel, MemoryTerm
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
 
@@ -60,8 +63,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
     title = "quasistatic viscoelastic body with long memory, normal compliance"
     contact_roles = ("normal_compliance",)
     history_columns = ("penetration_rms", "stress_L2")
-    scheme = (("memory", "update", ""), ("damage", "linear", "damage_"),
-              ("mech", "semismooth", "mech_"))
+    old_state = (("zeta", "zeta_old"),)  # u_{n-1} stays in u until (2.137) replaces it
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -70,7 +72,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
                                       "memory_amplitude": 1.0, "memory_rate": 1.0,
                                       "memory_mode": "auto"})
 
-    def __init__(self, data: ProblemData, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
@@ -137,6 +139,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         self._stress_sq = compat.form(ufl.inner(sigma, sigma) * ufl.dx)
         self.output_fields = [self.u, self.zeta, self.von_mises]
         self.timings = {"damage": 0.0, "memory": 0.0, "mech": 0.0}
+        self._prefixes = damage_prefix, mech_prefix
 
     def checkpoint_state(self) -> dict:
         """u, zeta and the memory M_n (running/recursive modes keep no other history)."""
@@ -148,12 +151,16 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         its = self._timed("mech", self.mech.solve)
         return {"mech_its": its}
 
-    def _advance(self) -> dict:
-        self._timed("memory", self.memory.update, self._g_map or self._g_expr)  # u_{n-1}, zeta_{n-1}
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        damage_its = self._timed("damage", self.damage.solve)
-        mech_its = self._timed("mech", self.mech.solve)
-        return {"damage_its": damage_its, "snes_its": mech_its}
+    def scheme(self) -> tuple:
+        """The memory M_n first, from g(u_{n-1}, zeta_{n-1}) (2.136), then the damage step (1.5)
+        and the displacement (2.137) by semismooth Newton."""
+        damage_prefix, mech_prefix = self._prefixes
+        return (SubStep("memory", "update", "",                                    # (2.136)
+                        partial(self.memory.update, self._g_map or self._g_expr)),
+                SubStep("damage", "linear", damage_prefix, self.damage.solve,      # (1.5)
+                        its=("damage_its",)),
+                SubStep("mech", "semismooth", mech_prefix, self.mech.solve,        # (2.137)
+                        its=("snes_its",)))
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)

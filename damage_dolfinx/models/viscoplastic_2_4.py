@@ -15,7 +15,6 @@ Prefixes: ``damage_``, ``friction_`` (``uzawa_``, ``pd_``).
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
 import ufl
@@ -30,7 +29,8 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.numerics.cellwise_stress import StressUpdate
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
-from damage_dolfinx.models.base import DAMAGE_A, Model, ProblemData
+from damage_dolfinx.problem import Problem
+from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
 
@@ -47,7 +47,7 @@ class ElastoViscoplasticFriction(Model):
     stability_limit = "explicit viscoplastic term: k <= 2/(1 - zeta*)"
     checkpoint_fields = ("u", "zeta", "w", "sigma")
     history_columns = ("stress_Q", "slip_max", "zeta_min_x", "zeta_min_y")
-    scheme = (("friction", "newton", "friction_"), ("damage", "snes-vi", "damage_"))  # (2), (4)
+    old_state = (("u", "u_old"), ("sigma", "sigma_old"), ("zeta", "zeta_old"))
 
     @classmethod
     def defaults(cls) -> ModelParameters:
@@ -72,7 +72,7 @@ class ElastoViscoplasticFriction(Model):
             return params.replace(friction_law="coulomb" if "coulomb" in roles else "tresca")
         return params
 
-    def __init__(self, data: ProblemData):
+    def __init__(self, data: Problem):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z, Q = compat.vector_p1(msh), compat.scalar_p1(msh), compat.tensor_dg0(msh)
@@ -113,7 +113,7 @@ class ElastoViscoplasticFriction(Model):
         g = fem.Constant(msh, float(x["g_fric"] if law == "tresca" else x["mu_f"] * abs(x["S_n"])))
         self.friction_problem = FrictionProblem(self.w, a, l, bcs, g, ds(GAMMA_C), self.context)
         self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.example_id)
+                                               data.id)
 
         # (4) damage obstacle step, source from step n-1 (variant A, no sigma dependence:
         # docs/models.md, section 2.4)
@@ -139,22 +139,21 @@ class ElastoViscoplasticFriction(Model):
     # t = 0: u_0 = 0, sigma_0 = 0 (the shared initial state): the first step absorbs f_N(0)
     # (docs/models.md, 2.4)
 
-    def _advance(self) -> dict:
-        self.u_old.x.array[:] = self.u.x.array
-        self.sigma_old.x.array[:] = self.sigma.x.array
-        self.zeta_old.x.array[:] = self.zeta.x.array
-        start = time.perf_counter()
+    def scheme(self) -> tuple:
+        """In the order of (2.184)-(2.187): the explicit updates (3) of u and sigma are the
+        sub-step ``stress``, before the damage step (4) (which reads u_{n-1} and zeta_{n-1})."""
+        return (SubStep("friction", "newton", "friction_", self._friction, its=("snes_its",)),
+                SubStep("stress", "update", "", self._stress),
+                SubStep("damage", "snes-vi", "damage_", self.damage.solve,          # (4)
+                        its=("damage_its",)))
+
+    def _friction(self) -> int:
         compat.interpolate(self.G_hat, self._G_expr)                       # (1)
-        friction_its = self.friction.solve()                               # (2)
-        middle = time.perf_counter()
+        return self.friction.solve()                                       # (2)
+
+    def _stress(self):
         self.u.x.array[:] = self.u_old.x.array + self.k * self.w.x.array  # (3)
-        self._stress_map()  # = compat.interpolate(self.sigma, self._sigma_expr)
-        end = time.perf_counter()
-        damage_its = self.damage.solve()                                   # (4)
-        self.timings["friction"] += middle - start
-        self.timings["stress"] += end - middle
-        self.timings["damage"] += time.perf_counter() - end
-        return {"damage_its": damage_its, "snes_its": friction_its}
+        self._stress_map()  # sigma_n = compat.interpolate(self.sigma, self._sigma_expr)
 
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)

@@ -39,6 +39,7 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics.contact import (NODAL_QUADRATURE, NODAL_QUADRATURE_3D,  # noqa: F401
                                              normal_compliance_pressure)
 
@@ -152,10 +153,18 @@ class ContactOutput:
         return F, -Fn / self.m[self.nodes], F - Fn[:, None] * self.nu
 
     def _forces(self):
-        """Owned entries of the nodal force vector: an assembled linear form, or A u - b of a
-        compiled (a, L) pair (a linear solve's forms, without its boundary conditions)."""
+        """Owned entries of the nodal force vector: an assembled linear form (into a vector
+        made once), or A u - b of a compiled (a, L) pair (a linear solve's forms, without its
+        boundary conditions)."""
         if not isinstance(self._force, tuple):
-            return _assemble(self._force)
+            if not hasattr(self, "_vector"):
+                self._vector = compat.create_vector(self._force)
+            vec = self._vector
+            with vec.localForm() as local:
+                local.set(0.0)
+            compat.assemble_vector(vec, self._force)
+            vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            return vec.getArray(readonly=True)
         a, L = self._force
         if not hasattr(self, "_matrix"):
             self._matrix = compat.create_matrix(a)
@@ -196,9 +205,8 @@ class ContactOutput:
                 sums += [np.sum(F_tau * tau), np.sum(m[sliding])]
             else:
                 sums += [*F_tau.sum(axis=0), np.sum(m[sliding])]
-        sums = self.comm.allreduce(np.array(sums, float), op=MPI.SUM)
-        peak = self.comm.allreduce(float(penetration.max()) if penetration.size else 0.0,
-                                   op=MPI.MAX)
+        sums, (peak,) = bookkeeping.sums_and_maxima(
+            self.comm, sums, [float(penetration.max()) if penetration.size else 0.0])
         d = self.dim
         size = sums[d + 1] if self.compliance else self.length  # bilateral: all of Gamma_C
         out = {"contact_normal_force": sums[0], f"contact_{self._size}": size,

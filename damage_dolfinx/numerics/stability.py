@@ -44,7 +44,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics import stability_bound
+from damage_dolfinx.numerics import stability_bound, stability_cache
 from damage_dolfinx.numerics.constitutive import B, eps
 from damage_dolfinx.parameters import InputError
 
@@ -301,8 +301,9 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
     k_max_lower_bound <= k_max. With a time step ``k`` at or below it the answer is clear and no
     eigenvalue is computed: ``k_max`` is None and ``decided_by`` is ``bound`` (inside
     stability_bound.exact_estimates() the eigensolve runs all the same). Otherwise the
-    eigensolved k_max, kept in memory by a hash of the matrices and m_visc (``decided_by``:
-    ``eigensolve`` or ``cache``)."""
+    eigensolved k_max, kept in memory and on disk (stability_cache.py) by a hash of the
+    matrices, m_visc and the eigen method (``decided_by``: ``eigensolve``, ``cache`` (this
+    process) or ``disk cache`` (an earlier process))."""
     K_B, K, M = stiffness_and_mass(V, E, nu, rho, c_nu, dsC, bcs, normal)
     try:
         rstart, rend = K.getOwnershipRange()
@@ -313,21 +314,32 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
         if k is not None and k <= lower and not stability_bound.exact_requested():
             return {**out, "k_max": None, "decided_by": "bound"}
         method_used = "slepc" if method != "power" and _slepc() else "power"
-        key = stability_bound.key((K_B, K, M), float(m_visc), method_used)
-        exact = stability_bound.cached(key)
-        decided_by = "cache"
+        key = stability_bound.key((K_B, K, M), float(m_visc), method_used, EIG_TOL,
+                                  stability_cache.FORMAT)
+        comm = K.getComm().tompi4py()
+        exact, decided_by = stability_bound.cached(key), "cache"
+        if exact is None:
+            exact, decided_by = stability_cache.load(key, comm), "disk cache"
+            if exact is not None:
+                stability_bound.store(key, exact)
         if exact is None:
             decided_by = "eigensolve"
             exact = _eigensolved(K_B, K, M, m_visc, method)
             exact["eigen_method"] = method_used
             stability_bound.store(key, exact)
+            stability_cache.save(key, exact, comm)
         return {**out, **exact, "decided_by": decided_by}
     finally:
         for A in {id(a): a for a in (K_B, K, M)}.values():
             A.destroy()
 
 
+#: eigensolves run in this process (what the caches save is counted here)
+EIGENSOLVES = {"count": 0}
+
+
 def _eigensolved(K_B, K, M, m_visc, method) -> dict:
+    EIGENSOLVES["count"] += 1
     omega2 = largest_eigenvalue(K, M, tol=EIG_TOL, method=method)
     k_prop = critical_time_step(omega2, m_visc)
     if K is K_B or math.isinf(m_visc):

@@ -28,9 +28,10 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 from petsc4py import PETSc
 
-#: eigensolved results by a hash of the assembled K_B, K, M, m_visc and the method: a restart in
-#: the same process, the points of a sweep and the levels of a convergence study on the same
-#: mesh and data solve the eigenproblems once
+#: eigensolved results of this process by a hash of the assembled K_B, K, M, m_visc and the
+#: method (stability_cache.py keeps them on disk for other processes): a restart, the points of
+#: a sweep and the levels of a convergence study on the same mesh and data solve the
+#: eigenproblems once
 _CACHE: dict = {}
 _EXACT = {"on": False}
 

@@ -7,6 +7,10 @@
 * :func:`extrema`: several minima and maxima of owned arrays in one Allreduce (min a = -max -a).
 * :func:`max_node_norm`: max over the nodes of |u(x_i)| from the squared components, without
   the temporary of numpy.linalg.norm (0.19 -> 0.02 ms).
+* :func:`sums_and_maxima`: sums and maxima over ranks in ONE Allreduce (an MPI operation that
+  adds the first entries and takes the maximum of the others); serially no MPI call.
+* :func:`local_dot`: x . y of the owned entries of two PETSc vectors, without the reduction of
+  ``Vec.dot`` (the reductions are then gathered into one).
 """
 from __future__ import annotations
 
@@ -43,3 +47,33 @@ def max_node_norm(values: np.ndarray, dim: int, comm) -> float:
     for c in range(1, dim):
         sq += values[c::dim] ** 2
     return float(np.sqrt(extrema(comm, maxima=[sq])[1][0])) if comm.size > 1 or sq.size else 0.0
+
+
+def _sum_then_max(inbuf, outbuf, datatype):
+    """MPI operation on float64 arrays [count, sums..., maxima...]: adds the ``count`` sums,
+    takes the maximum of the rest (count, the same on every rank, is kept)."""
+    a = np.frombuffer(inbuf, dtype=np.float64)
+    b = np.frombuffer(outbuf, dtype=np.float64)
+    k = int(b[0])
+    b[1:1 + k] += a[1:1 + k]
+    np.maximum(b[1 + k:], a[1 + k:], out=b[1 + k:])
+
+
+_SUM_THEN_MAX = []
+
+
+def sums_and_maxima(comm, sums=(), maxima=()) -> tuple[list, list]:
+    """(sum over ranks of each value in ``sums``, max over ranks of each in ``maxima``) in one
+    Allreduce (a minimum m is the maximum of -m)."""
+    buf = np.array([len(sums), *sums, *maxima], dtype=np.float64)
+    if comm.size > 1:
+        if not _SUM_THEN_MAX:
+            _SUM_THEN_MAX.append(MPI.Op.Create(_sum_then_max, commute=True))
+        comm.Allreduce(MPI.IN_PLACE, [buf, MPI.DOUBLE], op=_SUM_THEN_MAX[0])
+    k = len(sums)
+    return [float(x) for x in buf[1:1 + k]], [float(x) for x in buf[1 + k:]]
+
+
+def local_dot(x: PETSc.Vec, y: PETSc.Vec) -> float:
+    """x . y over this rank's owned entries (add over ranks to get the dot product)."""
+    return float(np.dot(x.getArray(readonly=True), y.getArray(readonly=True)))

@@ -233,10 +233,29 @@ def outcome(comm=MPI.COMM_WORLD):
         exc = failure if failure is not None else RankFailure(text, code, kind)
         for folder, where in folders:
             mark(folder, exc, alone, where)
-    if failure is not None and rank == comm.rank:
-        raise failure
-    raise RankFailure(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,
-                      kind) from failure
+    if failure is not None and (rank == comm.rank or classify(failure)[:2] == (code, kind)):
+        raise failure  # this rank's own exception is of the decided kind: the caller's catch
+    raise decided(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,
+                  kind) from failure
+
+
+def decided(text, code, kind) -> RankFailure:
+    """The decided failure on a rank that did not raise it: a RankFailure that is also of the
+    package's exception of its kind (``except dd.InputError`` catches it on every rank)."""
+    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.runtime.atomic import OutputError
+    from damage_dolfinx.numerics.solvers import ConvergenceError
+    base = {"error": InputError, "output error": OutputError,
+            "solver failure": ConvergenceError}.get(kind)
+    if base is None:
+        return RankFailure(text, code, kind)
+    cls = _DECIDED.get(base)
+    if cls is None:
+        cls = _DECIDED[base] = type(base.__name__, (RankFailure, base), {})
+    return cls(text, code, kind)
+
+
+_DECIDED: dict = {}
 
 
 def InputError_():

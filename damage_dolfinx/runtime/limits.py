@@ -28,7 +28,7 @@ def k_max(problem, comm=MPI.COMM_WORLD) -> float:
         return float(info.k_max(problem.parameters()))
     T = float(problem.T)
     small = T * 1e-6  # far below any limit: the model computes k_max without a warning
-    ex = dataclasses.replace(problem, k=small, allow_unstable=True).example()
+    ex = dataclasses.replace(problem, k=small, allow_unstable=True).checked()
     from damage_dolfinx.numerics.stability_bound import exact_estimates
     with exact_estimates():  # the eigensolved limit, not only the cheap bound below it
         stepper = ex.build(comm, ex.n, small, T)

@@ -36,7 +36,7 @@ class Run(RunRecords):
         ex = resolve(case, overrides)
         configured = ex.configure(n, k, T, h, overrides, mesh_file, comm)
         every = history_every if history_every is not None else \
-            configured[0].extra.get("history_every", 1)
+            configured.params.extra.get("history_every", 1)
         if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
                 or every < 1:
             raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
@@ -80,7 +80,8 @@ class Run(RunRecords):
         """False when a restart finds nothing to do (the summary is the previous one)."""
         ex, comm, o = self.ex, self.comm, self.options
         self.wall_start = time.perf_counter()
-        params, grid, n, h, mesh_file = self.configured
+        c = self.configured  # the problem as this run has it (Problem.configure)
+        params, grid, n, h, mesh_file = c.params, c.time, c.n, c.h, c.mesh_file
         self.grid = grid
         self.settings = {"example": ex.id, "n": n, "h": h, "k": grid.k,
                          "overrides": o["overrides"] or {},

@@ -1,9 +1,11 @@
 """The output folder: its lock (a second run into a folder where one is live is refused; a dead
 run's lock, even after SIGKILL, never blocks), the run it already holds, its manifest (what the
 package wrote in it: --overwrite removes exactly that, and a file the package did not write is
-never touched) and the checks of a mesh file before it is used (``check_mesh_file``)."""
+never touched), the rank-0 decision every rank receives (``decided``) and the lock of a
+folder shared by separate processes (``shared_folder_lock``); mesh files: meshfile.py."""
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import json
 import math
@@ -24,6 +26,10 @@ RUN_FILES = ("summary.json", "history.csv", "fields_final.npz", "checkpoint.json
              *checkpoint.GENERATIONS)
 
 
+class RunLive(InputError):
+    """A run is live in the folder (its lock is held): refused, and nothing there touched."""
+
+
 class RunLock:
     """``out/.lock``, held (flock) by rank 0 of the live run; the kernel drops it when that
     process dies, even by SIGKILL, so a dead run never blocks a new one. Raises InputError when
@@ -41,7 +47,7 @@ class RunLock:
             error = f"cannot lock {str(self.path)!r}: {exc.strerror or exc}"
         error = comm.bcast(error, root=0)
         if error:
-            raise InputError(error)
+            raise (RunLive if error.startswith("a run is live") else InputError)(error)
 
     def _acquire(self):
         for _ in range(10):  # the file may be replaced between open and flock (see release)
@@ -88,6 +94,36 @@ class RunLock:
                 pass
             os.close(self._fd)
             self._fd = None
+
+
+@contextlib.contextmanager
+def shared_folder_lock(out, comm, name=".sweep.lock"):
+    """Hold ``out/name`` locked (rank 0, flock; lockf where the file system has no flock) for
+    the body: separate processes writing the same folder (the jobs of a job array, each
+    running points of one sweep) take turns there. Waits for the holder; the kernel drops a
+    dead holder's lock. The file stays (never unlinked, so no two holders can ever hold two
+    different files)."""
+    fd, error = None, None
+    if comm.rank == 0:
+        try:
+            fd = os.open(Path(out) / name, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX)
+            except OSError:  # no flock here (some network file systems): POSIX record locks
+                fcntl.lockf(fd, fcntl.LOCK_EX)
+        except OSError as exc:
+            if fd is not None:
+                os.close(fd)
+                fd = None
+            error = f"cannot lock {str(Path(out) / name)!r}: {exc.strerror or exc}"
+    error = comm.bcast(error, root=0)
+    if error:
+        raise InputError(error)
+    try:
+        yield
+    finally:
+        if fd is not None:
+            os.close(fd)  # releases the lock
 
 
 def _alive(pid, host) -> bool:
@@ -152,8 +188,10 @@ def previous_run(out, comm):
 #: what the package wrote in a folder: {"schema", "kind": "run" | "study", "files": [names]}
 MANIFEST = "manifest.json"
 MANIFEST_SCHEMA = "damage-dolfinx/manifest/v1"
-#: names the package uses for its own bookkeeping (the lock, the writability probe)
-HIDDEN = (".lock",)
+#: names the package uses for its own bookkeeping (a run's lock, a sweep folder's lock)
+HIDDEN = (".lock", ".sweep.lock")
+#: the writability probe of io.prepare_output_dir (PROBE + pid, there for an instant)
+PROBE = ".damage-dolfinx-write-test-"
 #: files of a convergence study
 STUDY_FILES = ("summary.json", "errors.csv", "errors.md", "convergence.png")
 _LEGACY_FIELDS = re.compile(r"fields(_from_step\d+)?\.(xdmf|h5|xdmf\.bak)$")
@@ -161,7 +199,8 @@ _LEGACY_FIELDS = re.compile(r"fields(_from_step\d+)?\.(xdmf|h5|xdmf\.bak)$")
 
 def _ours(name, files) -> bool:
     """``name`` is a listed file or the temporary file of one (atomic.py: NAME.tmp)."""
-    return name in files or (name.endswith(".tmp") and name[:-4] in files) or name in HIDDEN
+    return name in files or (name.endswith(".tmp") and name[:-4] in files) or name in HIDDEN \
+        or name.startswith(PROBE)
 
 
 def read_manifest(out):
@@ -236,11 +275,22 @@ def claim_folder(out, kind, planned, restart, overwrite, comm, description=None,
     lists ``planned`` (and what a restart keeps). Returns True when an earlier run/study of
     this kind is there (before any overwrite). Raises InputError. ``apply`` False: the checks
     alone (nothing removed, no manifest written)."""
+    result = decided(comm, out, _claim, Path(out), kind, set(planned), restart, overwrite,
+                     description, apply)
+    if apply:
+        from damage_dolfinx.runtime.collective import track
+        track(out, kind)
+    return result
+
+
+def decided(comm, out, decide, *args):
+    """``decide(*args)`` run on rank 0 alone (it reads and writes the folder ``out``), its
+    result on every rank. An InputError it raises is raised on every rank, and so is an
+    OSError, as an InputError naming ``out`` (one line: nothing was done)."""
     result = None
     if comm.rank == 0:
         try:
-            result = _claim(Path(out), kind, set(planned), restart, overwrite, description,
-                            apply)
+            result = decide(*args)
         except InputError as exc:
             result = exc
         except OSError as exc:
@@ -248,9 +298,6 @@ def claim_folder(out, kind, planned, restart, overwrite, comm, description=None,
     result = comm.bcast(result, root=0)
     if isinstance(result, InputError):
         raise result
-    if apply:
-        from damage_dolfinx.runtime.collective import track
-        track(out, kind)
     return result
 
 
@@ -312,76 +359,4 @@ def add_to_manifest(out, names, comm):
 
 
 # ---------------------------------------------------------------------------- mesh files
-def check_mesh_file(path, dim, required_tags=(), comm=MPI.COMM_WORLD):
-    """A gmsh .msh file is readable, holds cells of topological dimension ``dim`` and facet
-    (dimension dim - 1) physical tags including every one of ``required_tags``; raises
-    InputError with one line naming the file and what is wrong (rank 0 reads, all ranks
-    raise). Read by gmsh's own reader, outside any DOLFINx call. ``required_tags`` may be a
-    callable returning them (evaluated on rank 0 only, after the file itself passed)."""
-    error = _mesh_problem(Path(path), dim, required_tags) if comm.rank == 0 else None
-    error = comm.bcast(error, root=0)
-    if error:
-        raise InputError(f"mesh file {str(path)!r}: {error}")
-
-
-def _mesh_problem(path, dim, required):
-    from damage_dolfinx.validation import cell_types_problem, mesh_path_problem
-    problem = mesh_path_problem(path)
-    if problem:
-        return problem
-    try:
-        size = path.stat().st_size
-        with open(path, "rb") as f:
-            head = f.read(64)
-    except OSError as exc:
-        return f"cannot be read ({exc.strerror or exc})"
-    if size == 0:
-        return "is empty"
-    if not head.lstrip().startswith(b"$MeshFormat"):
-        return "is not a gmsh .msh file (no $MeshFormat header)"
-    gmsh = _gmsh()
-    gmsh.model.add("check_mesh_file")
-    try:
-        try:
-            gmsh.merge(str(path))
-        except Exception as exc:  # noqa: BLE001 - gmsh raises a bare Exception
-            return f"gmsh cannot read it ({str(exc).splitlines()[0] if str(exc) else 'error'})"
-        got = gmsh.model.getDimension()
-        if got != dim or len(gmsh.model.mesh.getElementTypes(dim)) == 0:
-            return f"holds a {got}-D mesh, this example needs a {dim}-D one"
-        mixed = cell_types_problem(gmsh, dim)
-        if mixed:
-            return mixed
-        if not gmsh.model.getPhysicalGroups(dim):
-            return f"has no physical group of dimension {dim} (the cells)"
-        tags = {t for _, t in gmsh.model.getPhysicalGroups(dim - 1)}
-    finally:
-        gmsh.model.remove()
-    required = required() if callable(required) else required
-    missing = sorted(set(required) - tags)
-    if missing:
-        return (f"lacks the boundary tags {missing} this example needs (has "
-                f"{sorted(tags) or 'none'}; 1 = Gamma_D, 2 = Gamma_N, 3 = Gamma_C)")
-    return None
-
-
-def _gmsh():
-    """The gmsh module, initialised (gmsh 4.8 has no isInitialized; DOLFINx's reader finalises
-    gmsh after reading a file, behind geometries.gmsh_session's back)."""
-    import os
-    from damage_dolfinx.geometries import gmsh_session
-    gmsh = gmsh_session()
-    saved = os.dup(2)  # gmsh prints "not initialized" itself before raising
-    try:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 2)
-        os.close(devnull)
-        try:
-            gmsh.model.getCurrent()
-        except Exception:  # noqa: BLE001 - finalised: start it again
-            gmsh.initialize()
-            gmsh.option.setNumber("General.Terminal", 0)
-    finally:
-        os.dup2(saved, 2)
-        os.close(saved)
-    return gmsh
+from damage_dolfinx.runtime.meshfile import check_mesh_file  # noqa: E402,F401 (re-exported)

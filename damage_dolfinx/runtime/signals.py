@@ -2,6 +2,7 @@
 with a checkpoint, status "interrupted" and exit status 128 + signal (RunInterrupted)."""
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import threading
@@ -41,10 +42,24 @@ def stop_outside_runs(signum, frame):
     raise SignalStop(signum)
 
 
+@contextlib.contextmanager
+def keeping_sigint():
+    """Within it, an import that resets SIGINT (gmsh's module does; DOLFINx's io imports gmsh
+    where it is installed, in some versions) leaves the handler as it was (main thread)."""
+    main = threading.current_thread() is threading.main_thread()
+    handler = signal.getsignal(signal.SIGINT) if main else None
+    try:
+        yield
+    finally:
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
+
+
 def import_gmsh_keeping_sigint():
     """gmsh's Python module sets SIGINT to its default action (killing the process, with no
     line and no status) when it is first imported: import it now, if it is there, and put the
-    handler back."""
+    handler back. Every import of gmsh in the package goes through here, where gmsh is first
+    needed (it costs about 0.3 s, which a run on a built-in mesh does not pay)."""
     import sys
     if "gmsh" in sys.modules or threading.current_thread() is not threading.main_thread():
         return
@@ -68,7 +83,6 @@ class StopSignals:
 
     def __enter__(self):
         self.signum, self._previous, self._first = 0, {}, None
-        import_gmsh_keeping_sigint()
         if threading.current_thread() is threading.main_thread():
             self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
         return self

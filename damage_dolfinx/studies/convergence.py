@@ -337,7 +337,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     settings = {"example": ex.id, "reading": ex.reading, "ref_n": ref_n, "ref_k": ref_k,
                 "T": T, "n": ns, "k": ks,
                 "parameters": json.loads(io.strict_json(
-                    ex.configure(n=ref_n, k=ref_k, T=T, overrides=overrides)[0].as_dict()))}
+                    ex.configure(n=ref_n, k=ref_k, T=T, overrides=overrides).params.as_dict()))}
     previous = _previous_study(out, comm)
     if restart and previous is not None and previous.get("status") == "completed":
         differ = [key for key in settings if previous.get(key) != settings[key]]

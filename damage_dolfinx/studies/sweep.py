@@ -1,28 +1,45 @@
 """Parameter sweeps: one problem run over a grid of parameter values, each point a normal run
-folder, the points shared out among the ranks, resumable, gathered into one table and a plot.
+folder, the points shared out among groups of ranks or among separate jobs, resumable,
+gathered into one table and a plot.
 
-Layout of the sweep folder ``out``::
+Layout of the sweep folder ``out`` (sweep_folder.py: how several processes share it)::
 
-    points.json    the grid, and for every point its folder and parameter values
+    points.json    the grid, and for every point its index, folder and parameter values
     point_<i>/     the run folder of point i (summary.json, history.csv, fields.xdmf, ...)
-    sweep.csv      one row per point: its parameter values, status and final scalars
+    sweep.csv      one row per point, in the order of the points: its parameter values,
+                   status and final scalars
     sweep.png      a chosen scalar against the swept parameters
     summary.json   the sweep's own summary
 
 The points are the Cartesian product of the grid's value lists, in the order of the grid's
-keys (the last key varies fastest). Each rank runs its share of the points one after another
-on its own (``MPI.COMM_SELF``), as :func:`damage_dolfinx.converge` shares out its coarse cells;
-a problem whose mesh was built on all ranks (not a mesh family or a file) runs its points on
-all ranks together instead. A point whose ``summary.json`` says "completed" is kept as it is
-when the sweep runs again; a point that was interrupted reruns from its checkpoint with
-``restart=True``, or from the start otherwise.
+keys (the last key varies fastest); point ``i`` (0-based) is row ``i`` of ``sweep.csv``.
+
+Who runs which point:
+
+* ``ranks_per_point = R`` (default 1) splits the ranks into groups of R consecutive ranks
+  (``comm.Split``); group g runs the points g, g + G, g + 2G, ... of those still to run (G
+  groups, round robin), each point in parallel on its R ranks. R must divide the number of
+  ranks. R = 1 is every rank running its share alone (``MPI.COMM_SELF``), as
+  :func:`damage_dolfinx.converge` shares out its coarse cells. A problem whose mesh was built
+  on all ranks (not a mesh family or a file) runs its points on all ranks together (R = the
+  number of ranks).
+* ``point = i`` runs point i alone, on all ranks of the call: a job of a scheduler's job
+  array, each job one point, all writing the same folder (the first creates it, the others
+  check that their grid and problem are the same; a completed point is not run again).
+
+A point whose ``summary.json`` says "completed" is kept as it is when the sweep runs again; a
+point that was interrupted reruns from its checkpoint with ``restart=True``, or from the
+start otherwise; a point live in another process is left to it.
+
+Failures: a point that fails on every rank of its group (a solver, a refused value, an
+exception of user code raised alike) is recorded as failed and the sweep goes on (the
+sweep's status "failed", exit status 3 on the command line); an exception on some ranks of a
+group only, or a signal, ends the whole sweep within seconds (runtime/collective.py), with
+one line and the statuses written.
 """
 from __future__ import annotations
 
-import csv
-import io as io_module
 import itertools
-import json
 import math
 import time
 from pathlib import Path
@@ -30,11 +47,9 @@ from pathlib import Path
 from mpi4py import MPI
 
 from damage_dolfinx.parameters import InputError
-
-#: points.json schema
-SCHEMA = "damage-dolfinx/sweep/v1"
-#: summary columns of every point in sweep.csv, before the model's final scalars
-STATUS_COLUMNS = ["status", "steps_done", "t_final", "wall_time_s"]
+from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
+                                                 SWEEP_FILES, plot_sweep)
+from damage_dolfinx.studies.sweep_folder import describe_values as _describe
 
 
 def parse_values(text: str, name: str) -> list:
@@ -91,26 +106,9 @@ def _runs_on_all_ranks(case) -> bool:
     return not (callable(mesh) and not isinstance(mesh, tuple))
 
 
-def _state(folder: Path) -> str:
-    """'completed', 'checkpoint' (interrupted, resumable), 'started' or 'new'."""
-    try:
-        status = json.loads((folder / "summary.json").read_text()).get("status")
-    except (OSError, ValueError):
-        status = None
-    if status == "completed":
-        return "completed"
-    if (folder / "checkpoint.json").is_file():
-        return "checkpoint"
-    return "started" if folder.exists() else "new"
-
-
-def _describe(values: dict) -> str:
-    return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                     for k, v in values.items())
-
-
 def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_points=None,
-          plot="zeta_min", figures=True, progress=True, comm=MPI.COMM_WORLD) -> dict:
+          plot="zeta_min", figures=True, progress=True, ranks_per_point=None, point=None,
+          comm=MPI.COMM_WORLD) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem` or a catalogue id) at every point of
     ``grid`` = ``{parameter: [values]}`` into ``out/point_<i>``; returns the sweep summary.
 
@@ -120,238 +118,224 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     rerun, from their checkpoint with ``restart=True``. ``max_points``: run at most this many
     of the points not yet finished, then stop (the others stay pending). ``plot``: the final
     scalar drawn against the swept parameters in ``sweep.png``. ``n``, ``k``, ``T`` apply to
-    every point."""
+    every point. ``ranks_per_point``: the size of the groups of ranks that each run one point
+    in parallel (a divisor of the number of ranks; default 1). ``point``: run only this point
+    (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
+    processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.validation import check_sweep
     with outcome(comm):
         checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress)
-        return _sweep(problem, out, grid, comm=comm, **checked)
+        layout = _check_layout(ranks_per_point, point, checked["max_points"], comm)
+        return _sweep(problem, out, grid, comm=comm, **checked, **layout)
+
+
+def _check_layout(ranks_per_point, point, max_points, comm) -> dict:
+    """ranks_per_point and point, refused (InputError) before any work when they cannot be."""
+    from damage_dolfinx.validation import whole
+    size = comm.size
+    ranks = whole("ranks_per_point", ranks_per_point, allow_none=True)
+    point = whole("point", point, low=0, allow_none=True)
+    if ranks is not None and size % ranks:
+        divisors = [d for d in range(1, size + 1) if size % d == 0]
+        raise InputError(f"{ranks} ranks per point do not divide the {size} rank(s) of the sweep "
+                         f"(possible: {', '.join(map(str, divisors))})")
+    if point is not None and ranks not in (None, size):
+        raise InputError(f"a single point runs on all {size} rank(s) of the call, not on "
+                         f"{ranks} ranks per point")
+    if point is not None and max_points is not None:
+        raise InputError("a single point and a maximum number of points exclude each other")
+    return {"ranks_per_point": ranks, "point": point}
+
+
+def _shared(ex, grid) -> dict:
+    """What every point shares besides n, k, T (points.json "shared"): the model, the reading
+    and the parameters not swept (those a file can hold: numbers, text, flags)."""
+    params = {}
+    for name, value in ex.params.as_dict().items():
+        if name not in grid and (value is None or isinstance(value, (bool, int, float, str))):
+            params[name] = value if not (isinstance(value, float) and not math.isfinite(value)) \
+                else str(value)
+    return {"model": ex.model_id, "reading": ex.reading, "parameters": params}
 
 
 def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, progress,
-           comm) -> dict:
+           ranks_per_point, point, comm) -> dict:
     from damage_dolfinx.runtime import io
-    from damage_dolfinx.runtime.collective import describe, mark, track
+    from damage_dolfinx.runtime.collective import classify, describe, mark, track
+    from damage_dolfinx.runtime.runfolder import RunLive
     from damage_dolfinx.runtime.runner import resolve
     from damage_dolfinx.runtime.runner import run as run_one
-    from damage_dolfinx.runtime.signals import RunInterrupted
+    from damage_dolfinx.studies.sweep_folder import open_sweep, record
 
     wall_start = time.perf_counter()
     grid = check_grid(grid)
     points = grid_points(grid)
+    if point is not None and point >= len(points):
+        raise InputError(f"point {point} is not in the grid: its {len(points)} points are "
+                         f"0 to {len(points) - 1}")
+    together = _runs_on_all_ranks(problem)
+    size = comm.size
+    if together and ranks_per_point not in (None, size):
+        raise InputError(f"the problem's mesh is built on all {size} rank(s): every point runs "
+                         f"on all of them, not on {ranks_per_point} ranks per point")
+    ranks = ranks_per_point or (size if together or point is not None else 1)
     ex = resolve(problem)
     checked_at = time.perf_counter()
-    for i, values in enumerate(points):  # every point is checked before any work
-        ex.configure(n, k, T, None, dict(values))
+    for i in (range(len(points)) if point is None else [point]):  # checked before any work
+        ex.configure(n, k, T, None, dict(points[i]))
         if progress and comm.rank == 0 and time.perf_counter() - checked_at > 2.0:
             checked_at = time.perf_counter()
             print(f"[sweep {ex.id}] checking the grid: {i + 1}/{len(points)} points",
                   flush=True)
-    out = Path(out)
     mapping = {"schema": SCHEMA, "case": ex.id, "grid": grid, "n": n, "k": k, "T": T,
                "points": [{"index": i, "folder": f"point_{i}", "values": values}
-                          for i, values in enumerate(points)]}
-    existing = None
-    if comm.rank == 0 and (out / "points.json").is_file():
-        try:
-            existing = json.loads((out / "points.json").read_text())
-        except ValueError:
-            existing = {}
-    existing = comm.bcast(existing, root=0)
-    if existing is not None and {key: existing.get(key) for key in mapping} != \
-            json.loads(json.dumps(mapping)):
-        raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
-                         "T in its points.json); choose another out folder")
+                          for i, values in enumerate(points)],
+               "shared": _shared(ex, grid)}
     out = io.prepare_output_dir(out, comm)
-    states = claim_sweep_folder(out, len(points), restart, comm)
-    track(out, "sweep")
-    if comm.rank == 0:
-        io.write_json(out / "points.json", mapping, comm)
-        io.write_json(out / "summary.json", {"schema": SCHEMA, "case": ex.id, "status": "running",
-                                              "points": len(points)}, comm)
+    states = open_sweep(out, mapping, point, comm)
+    if point is None:  # a job of one point leaves the sweep's status to the record (others run)
+        track(out, "sweep")
 
-    pending = [i for i, s in enumerate(states) if s != "completed"]
-    todo = pending[:max_points] if max_points else pending
-    together = _runs_on_all_ranks(problem) and comm.size > 1
-    mine = todo if together else todo[comm.rank::comm.size]
-    run_comm = comm if together else MPI.COMM_SELF
-    if comm.rank == 0 and progress:
-        print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
-              f"running {len(todo)} on {comm.size} rank(s)", flush=True)
-    failures = {}
-    for i in mine:
-        values = points[i]
-        folder = out / f"point_{i}"
-        resume = restart and states[i] == "checkpoint"
-        start = time.perf_counter()
-        try:
-            summary = run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
-                              progress=False, figures=figures, restart=resume,
-                              overwrite=not resume, comm=run_comm)
-            status = summary["status"]
-        except (RunInterrupted, KeyboardInterrupt):
-            raise  # the sweep stops (collective.outcome decides for every rank)
-        except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
-            if together:
-                raise
-            if run_comm.rank == 0:
-                mark(folder, exc)
-            status = f"failed ({describe(exc)})"
-            failures[i] = describe(exc)
-        if progress and run_comm.rank == 0:
-            print(f"[sweep {ex.id}] point {i} ({_describe(values)}): {status} in "
-                  f"{time.perf_counter() - start:.1f} s (rank {comm.rank})", flush=True)
-    failures = {i: why for part in comm.allgather(failures) for i, why in part.items()}
-
-    summary = None
-    if comm.rank == 0:
-        rows, scalars = [], []
-        for i, values in enumerate(points):
-            row = {"point": i, "folder": f"point_{i}", **values}
-            try:
-                s = json.loads((out / f"point_{i}" / "summary.json").read_text())
-            except (OSError, ValueError):
-                s = {"status": "pending"}
-            row.update({c: s.get(c, "") for c in STATUS_COLUMNS})
-            for key, value in (s.get("final") or {}).items():
-                if isinstance(value, (int, float)) and not isinstance(value, bool):
-                    row[key] = value
-                    if key not in scalars:
-                        scalars.append(key)
-            rows.append(row)
-        columns = ["point", "folder", *grid, *STATUS_COLUMNS, *scalars]
-        def table(f):
-            text = io_module.StringIO()
-            writer = csv.DictWriter(text, fieldnames=columns, restval="")
-            writer.writeheader()
-            writer.writerows(rows)
-            f.write(text.getvalue().encode())
-        io.collective(MPI.COMM_SELF, out, "sweep.csv", io.atomic_write_bytes, out / "sweep.csv",
-                      table)
-        done = [r for r in rows if r["status"] == "completed"]
-        if plot and plot not in scalars and done:  # the runs are kept: a warning, no plot
-            import sys
-            print(f"damage-dolfinx: warning: no plot: {plot!r} is not a final scalar of this "
-                  f"problem (known: {', '.join(scalars)})", file=sys.stderr, flush=True)
-            plot = None
-        if plot and done:
-            io.collective(MPI.COMM_SELF, out, "sweep.png", plot_sweep, out / "sweep.png", done,
-                          grid, plot, ex.id)
-        failed = sorted(i for i, r in enumerate(rows) if str(r["status"]).startswith("failed")
-                        or i in failures)
-        status = "failed" if failed else ("completed" if len(done) == len(points) else
-                                          "incomplete")
-        summary = {"schema": SCHEMA, "case": ex.id, "status": status, "grid": grid,
-                   "points": len(points), "completed": len(done), "failed": failed,
-                   "errors": {str(i): why for i, why in sorted(failures.items())},
-                   **({"error": f"{len(failed)} of {len(points)} points failed"} if failed
-                      else {}),
-                   "pending": [r["point"] for r in rows if r["status"] != "completed"],
-                   "ran": todo, "mpi_size": comm.size, "points_on_all_ranks": together,
-                   "csv": "sweep.csv", "plot": "sweep.png" if plot and done else None,
-                   "wall_time_s": time.perf_counter() - wall_start}
-        io.write_json(out / "summary.json", summary, comm)
-        if progress:
-            print(f"[sweep {ex.id}] {len(done)}/{len(points)} points completed"
-                  + (f", {len(failed)} failed" if failed else "") + " in "
-                  f"{summary['wall_time_s']:.1f} s; table {out / 'sweep.csv'}", flush=True)
-    return comm.bcast(summary, root=0)
-
-
-def claim_sweep_folder(out, count, restart, comm) -> list:
-    """The folder rules for a sweep (rank 0 decides, every rank gets the answer): a folder
-    holding a run or a convergence study is refused, and so are files the package did not
-    write (in the folder or in a point's folder); the manifest then lists the sweep's files
-    and point folders. Returns the state of every point (``_state``)."""
-    from damage_dolfinx.runtime import runfolder
-    result = None
-    if comm.rank == 0:
-        try:
-            result = _claim_sweep(Path(out), count)
-        except InputError as exc:
-            result = exc
-        except OSError as exc:
-            result = InputError(f"cannot use {str(out)!r}: {exc.strerror or exc}")
-    result = comm.bcast(result, root=0)
-    if isinstance(result, InputError):
-        raise result
-    del runfolder
-    return result
-
-
-def _claim_sweep(out: Path, count: int) -> list:
-    from damage_dolfinx.runtime import runfolder
-    names = {f"point_{i}" for i in range(count)} | set(SWEEP_FILES)
-    present = {p.name for p in out.iterdir()}
-    known = runfolder.read_manifest(out)
-    if known is not None and known[0] != "sweep":
-        what = {"run": "a run", "study": "a convergence study"}[known[0]]
-        raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
-                         "choose another --out (nothing was touched)")
-    if known is None:
-        legacy = runfolder.folder_contents(out)[0]
-        if legacy is not None:
-            what = {"run": "a run", "study": "a convergence study"}[legacy]
-            raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
-                             "choose another --out (nothing was touched)")
-        ours = set() if "points.json" not in present else \
-            {n for n in present if n in names}  # a sweep written before manifests
+    if point is not None:
+        pending = [] if states[point] == "completed" else [point]
+        todo = pending
     else:
-        ours = known[1]
-    others = present - ours - {runfolder.MANIFEST, *runfolder.HIDDEN} - \
-        {n + ".tmp" for n in ours}
-    if others:
-        raise InputError(f"{str(out)!r} holds {runfolder._listing(others)}, not written by "
-                         f"damage-dolfinx (not in its {runfolder.MANIFEST}): move them or "
-                         "choose another --out (nothing was touched)")
-    states = []
-    for i in range(count):
-        folder = out / f"point_{i}"
-        state = _state(folder)
-        if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
-            raise InputError(f"{str(folder)!r} is not a folder of this sweep: move it or choose "
-                             "another --out (nothing was touched)")
-        if folder.is_dir():
-            kind, _, strangers = runfolder.folder_contents(folder)
-            if strangers:
-                raise InputError(f"{str(folder)!r} holds {runfolder._listing(strangers)}, not "
-                                 "written by damage-dolfinx: move them or choose another --out "
-                                 "(nothing was touched)")
-            if kind not in (None, "run"):
-                raise InputError(f"{str(folder)!r} holds a convergence study: choose another "
-                                 "--out (nothing was touched)")
-        states.append(state)
-    runfolder.write_manifest(out, "sweep", names | (ours & present))
-    return states
+        pending = [i for i, s in enumerate(states) if s != "completed"]
+        todo = pending[:max_points] if max_points else pending
+    groups, color = size // ranks, comm.rank // ranks
+    group = comm if ranks == size else MPI.COMM_SELF if ranks == 1 else \
+        comm.Split(color, comm.rank)
+    mine = todo[color::groups]
+    relay = _Relay(comm)
+    if comm.rank == 0 and progress:
+        if point is not None and not todo:
+            print(f"[sweep {ex.id}] point {point} ({_describe(points[point])}) is already "
+                  "completed: nothing to do", flush=True)
+        elif point is not None:
+            print(f"[sweep {ex.id}] point {point} of {len(points)} "
+                  f"({_describe(points[point])}) on {size} rank(s)", flush=True)
+        else:
+            layout = f"{groups} group(s) of {ranks} rank(s)" if ranks > 1 else \
+                f"{size} rank(s)"
+            print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
+                  f"running {len(todo)} on {layout}", flush=True)
+    failures = {}
+    try:
+        for i in mine:
+            values = points[i]
+            folder = out / f"point_{i}"
+            resume = restart and states[i] == "checkpoint"
+            start = time.perf_counter()
+            try:
+                summary = _point_outcome(
+                    group, comm, [(folder, "run")] + ([(out, "sweep")] if point is None else []),
+                    lambda: run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
+                                    progress=False, figures=figures, restart=resume,
+                                    overwrite=not resume, comm=group))
+                status = summary["status"]
+            except RunLive:
+                if point is not None:
+                    raise  # the one point asked for is live elsewhere: refused
+                status = "live in another process, left to it"
+            except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
+                if classify(exc)[2] == "interrupted":
+                    raise  # the sweep stops (collective.outcome decides for every rank)
+                if group.rank == 0:
+                    mark(folder, exc)
+                status = f"failed ({describe(exc)})"
+                failures[i] = describe(exc)
+            if progress and group.rank == 0:
+                where = f"rank {comm.rank}" if ranks == 1 else \
+                    f"ranks {comm.rank}-{comm.rank + ranks - 1}"
+                relay.say(f"[sweep {ex.id}] point {i} ({_describe(values)}): {status} in "
+                          f"{time.perf_counter() - start:.1f} s ({where})")
+    finally:
+        if group not in (comm, MPI.COMM_SELF):
+            group.Free()
+    failures = {i: why for part in comm.allgather(failures) for i, why in part.items()}
+    relay.close()
+    info = {"ran": todo, "mpi_size": size, "ranks_per_point": ranks, "groups": groups,
+            "point": point, "points_on_all_ranks": ranks == size and size > 1,
+            "wall_time_s": time.perf_counter() - wall_start}
+    summary = record(out, mapping, failures, info, plot, ex.id, comm)
+    summary = dict(summary, failed_in_this_call=sorted(failures))
+    if comm.rank == 0 and progress:
+        failed = summary["failed"]
+        print(f"[sweep {ex.id}] {summary['completed']}/{len(points)} points completed"
+              + (f", {len(failed)} failed" if failed else "") + " in "
+              f"{summary['wall_time_s']:.1f} s; table {out / 'sweep.csv'}", flush=True)
+    return summary
 
 
-#: files of a sweep folder (besides point_<i>/ and the manifest)
-SWEEP_FILES = ("points.json", "sweep.csv", "sweep.png", "summary.json")
+def _point_outcome(group, comm, folders, body):
+    """``body()`` on every rank of ``group`` (the ranks running one point), with one outcome on
+    all of them: its value, or the same exception everywhere (a failing rank's own, the others
+    a collective.RankFailure of the same kind carrying its line). A rank that failed while its
+    partners do not join within collective.FAIL_WAIT seconds (they are blocked in a collective call it left)
+    ends the whole sweep: ``folders`` get the status, one line, MPI_Abort with its exit status
+    (collective.py's rule, here within one group while the sweep's other groups go on)."""
+    if group.size == 1:
+        return body()
+    from damage_dolfinx.runtime import collective
+    agree = group.Dup()  # before the body: a rank that fails inside it can still join
+    failure, value = None, None
+    try:
+        value = body()
+    except BaseException as exc:  # noqa: BLE001 - decided by the whole group below
+        failure = exc
+    mine = None if failure is None else \
+        (group.rank, *collective.classify(failure)[:2], collective.describe(failure))
+    request = agree.Ibarrier()
+    deadline = time.monotonic() + collective.FAIL_WAIT
+    while not request.Test():
+        if failure is not None and time.monotonic() > deadline:
+            collective._abort(comm, failure, folders)
+        time.sleep(0.002)
+    outcomes = agree.allgather(mine)
+    agree.Free()
+    failed = [o for o in outcomes if o is not None]
+    if not failed:
+        return value
+    if failure is not None:
+        raise failure
+    _, code, kind, text = failed[0]
+    raise collective.decided(text, code, kind)
 
 
-def plot_sweep(path, rows, grid, scalar, label):
-    """``scalar`` against the first swept parameter with several values, one line per
-    combination of the others."""
-    from damage_dolfinx.viz import figstyle
-    names = list(grid)
-    x_name = next((name for name in names if len(grid[name]) > 1), names[0])
-    others = [name for name in names if name != x_name]
-    fig, ax = figstyle.plt().subplots(figsize=(6.4, 4.2))
-    numeric = all(isinstance(v, (int, float)) for v in grid[x_name])
-    for combo in itertools.product(*(grid[name] for name in others)):
-        sel = [r for r in rows if all(r[name] == v for name, v in zip(others, combo))]
-        if not sel:
-            continue
-        order = grid[x_name]
-        sel.sort(key=lambda r: order.index(r[x_name]))
-        xs = [r[x_name] if numeric else str(r[x_name]) for r in sel]
-        ax.plot(xs, [r[scalar] for r in sel], "o-", ms=5,
-                label=_describe(dict(zip(others, combo))) or None)
-    if numeric and min(grid[x_name]) > 0 and max(grid[x_name]) >= 10 * min(grid[x_name]):
-        ax.set_xscale("log")
-    ax.set_xlabel(x_name)
-    ax.set_ylabel(scalar)
-    ax.grid(True, alpha=0.3)
-    if others:
-        ax.legend(fontsize=8)
-    figstyle.save(fig, path, title=f"{label}: {scalar} over the sweep")
+class _Relay:
+    """Progress lines of the groups' first ranks, printed by rank 0 alone (only rank 0
+    prints): rank 0 prints its own at once and the others' as they arrive, between its points
+    and at the end."""
+
+    TAG = 4242
+
+    def __init__(self, comm):
+        self.comm = comm.Dup() if comm.size > 1 else comm
+        self.sent, self.received, self.requests = 0, 0, []
+
+    def say(self, text):
+        if self.comm.rank == 0:
+            self._drain()
+            print(text, flush=True)
+        else:
+            self.requests.append(self.comm.isend(text, dest=0, tag=self.TAG))
+            self.sent += 1
+
+    def _drain(self):
+        status = MPI.Status()
+        while self.comm.size > 1 and self.comm.iprobe(source=MPI.ANY_SOURCE, tag=self.TAG,
+                                                      status=status):
+            print(self.comm.recv(source=status.Get_source(), tag=self.TAG), flush=True)
+            self.received += 1
+
+    def close(self):
+        """Collective: every line sent is printed before the summary line."""
+        if self.comm.size == 1:
+            return
+        counts = self.comm.gather(self.sent, root=0)
+        if self.comm.rank == 0:
+            for _ in range(sum(counts) - self.received):
+                print(self.comm.recv(source=MPI.ANY_SOURCE, tag=self.TAG), flush=True)
+        MPI.Request.Waitall(self.requests)
+        self.comm.Free()

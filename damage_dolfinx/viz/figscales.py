@@ -78,3 +78,12 @@ def range_decimals(lo: float, hi: float, nticks: int = 4) -> int:
     """Decimals that write ticks over [lo, hi] as distinct numbers (never '1, 1, 0.9999')."""
     step = (hi - lo) / max(1, nticks)
     return int(min(8, max(0, math.ceil(-math.log10(step)) if step > 0 else 2)))
+
+
+def range_text(lo: float, hi: float) -> str:
+    """"[lo, hi]" with 3 significant digits, more where 3 would write two different values
+    as one (a damage range [0.9999969, 1] is never titled "[1, 1]")."""
+    digits = 3
+    while lo != hi and digits < 12 and f"{lo:.{digits}g}" == f"{hi:.{digits}g}":
+        digits += 1
+    return f"[{lo:.{digits}g}, {hi:.{digits}g}]"

@@ -14,18 +14,19 @@ Rules, each applied here and nowhere else:
 * tight layouts, colour bars exactly as tall as their axes, mathtext labels (Gamma_D -> Γ_D, ...).
 
 Pure matplotlib/numpy: no dolfinx here (post.py gathers the data and calls these functions).
+The saved panel data (figpanels.py) and the setting figures (figsetting.py) are modules of their
+own, reached through this one as well (``figstyle.save_panels``, ``figstyle.draw_setting``).
 """
 from __future__ import annotations
 
-import json
 import math
 import re
-from pathlib import Path
 
 import numpy as np
 
+from . import fastdraw
 from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks, range_decimals,  # noqa: F401
-                        is_damage, narrow_damage, shared_limits, si_unit)
+                        is_damage, narrow_damage, range_text, shared_limits, si_unit)
 from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
                       error_mathtext, is_round, mathtext, round_amplification)
 from .setting_geometry import (outward_normals, spread, support_hatch,  # noqa: F401
@@ -68,6 +69,7 @@ def triangle_edges(ax, xy, colour="k", linewidth=0.35, zorder=2):
     patch = PathPatch(triangle_path(xy), facecolor="none", edgecolor=colour,
                       linewidth=linewidth, zorder=zorder, joinstyle="miter", capstyle="butt")
     patch.set_rasterized(len(xy) > RASTERISE_CELLS)
+    fastdraw.out_of_layout(patch)
     ax.add_artist(patch)  # add_patch would walk the 10^5 segments for the data limits
     ax.update_datalim(np.asarray(xy, dtype=float).reshape(-1, 2))
     return patch
@@ -84,6 +86,7 @@ def draw_field(ax, tri, values, cmap, vmin, vmax):
     im = TriMesh(tri, array=per_vertex, cmap=cmap)
     im.set_clim(vmin, vmax)
     im.set_rasterized(len(per_vertex) // 3 > RASTERISE_CELLS)
+    fastdraw.out_of_layout(im)
     ax.grid(False)
     ax.update_datalim([(tri.x.min(), tri.y.min()), (tri.x.max(), tri.y.max())])
     ax.autoscale_view()
@@ -97,7 +100,8 @@ def plt():
     matplotlib.use("Agg")
     import matplotlib.pyplot as pyplot
     pyplot.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
-                            "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False})
+                            "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False,
+                            "figure.dpi": DPI})  # laid out as saved: text extents measured once
     return pyplot
 
 
@@ -109,7 +113,7 @@ def ticker():
 
 def save_as_laid_out(fig, path, dpi=300):
     """Save a figure whose layout and title its caller set (tight bounding box), and close it."""
-    fig.savefig(path, dpi=dpi, bbox_inches="tight")
+    fig.savefig(path, dpi=dpi, bbox_inches="tight", **fastdraw.png_options(path))
     plt().close(fig)
 
 
@@ -294,7 +298,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
                 if faint:  # the range of the field, on the fixed bar
                     cb.ax.axhspan(lo, hi, xmin=0, xmax=1, facecolor="none", edgecolor="red", lw=1.2)
                 ax.set_title(p.get("title", "damage $\\zeta$") + (f"\n{note}" if note else
-                             f"\n$\\zeta$ in [{lo:.3g}, {hi:.3g}]"),
+                             f"\n$\\zeta$ in {range_text(lo, hi)}"),
                              color="firebrick" if note else "k")
                 if faint:
                     stretched.append((ax, tri, vals, lo, hi))
@@ -317,7 +321,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     full = mathtext(title) + f" — {amplification_text(amplification)}{replaced}"
     fig.tight_layout()
     suptitle_on_top(fig, full)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    fig.savefig(path, dpi=DPI, bbox_inches=_tight(fig), **fastdraw.png_options(path))
     pyplot.close(fig)
     return used
 
@@ -330,7 +334,7 @@ def _stretched_damage(fig, ax, tri, vals, lo, hi):
     digits = range_decimals(lo, hi)
     cb.ax.yaxis.set_major_locator(MaxNLocator(4))
     cb.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.{digits}f}"))
-    ax.set_title(f"the same damage, colours stretched\nto its range [{lo:.3g}, {hi:.3g}]")
+    ax.set_title(f"the same damage, colours stretched\nto its range {range_text(lo, hi)}")
 
 
 #: colour map of the stretched damage panel: the damage's own (one colour map per field); its
@@ -341,171 +345,11 @@ STRETCHED_CMAP = DAMAGE_CMAP
 def suptitle_on_top(fig, text):
     """The figure title just above the axes' titles (equal-aspect axes shrink inside their
     slot; a default suptitle would float over an empty band)."""
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
+    renderer = fig.canvas.get_renderer()  # no draw first: get_tightbbox applies the aspect
+    # and updates the ticks itself (a full draw here doubled the text layout work)
     inv = fig.transFigure.inverted()
     top = max(ax.get_tightbbox(renderer).transformed(inv).y1 for ax in fig.axes)
     fig.suptitle(text, y=top + 0.01, va="bottom")
-
-
-def save_panels(path, panels, **meta):
-    """The data behind a field figure (``<png stem>.panel.npz`` + JSON meta; not ``.npz``, which would overwrite a run's fields_final.npz behind fields_final.png), so that a thesis pair can be
-    re-rendered on a shared stress scale after both runs finished (:func:`render_saved`)."""
-    path = Path(path)
-    arrays = {}
-    for i, p in enumerate(panels):
-        arrays[f"xy{i}"], arrays[f"v{i}"] = np.asarray(p["xy"]), np.asarray(p["values"])
-    if meta.get("ref_xy") is not None:
-        arrays["ref_xy"] = np.asarray(meta.pop("ref_xy"))
-    else:
-        meta.pop("ref_xy", None)
-    meta["panels"] = [{"name": p.get("name", ""), "label": p.get("label", "")} for p in panels]
-    arrays["meta"] = np.array(json.dumps(meta))
-    np.savez_compressed(path.with_suffix(PANEL_SUFFIX), **arrays)
-
-
-def load_panels(npz):
-    d = np.load(npz)
-    meta = json.loads(str(d["meta"]))
-    panels = [dict(info, xy=d[f"xy{i}"], values=d[f"v{i}"]) for i, info in enumerate(meta["panels"])]
-    return panels, meta, (d["ref_xy"] if "ref_xy" in d else None)
-
-
-def render_saved(npz, png, limits=None, guides=None) -> list:
-    panels, meta, ref = load_panels(npz)
-    return render_fields(panels, png, title=meta.get("title", ""),
-                         amplification=meta.get("amplification", 1.0), ref_xy=ref,
-                         zeta_star=meta.get("zeta_star"), mesh_only=meta.get("mesh_only", False),
-                         limits=limits, guides=guides)
-
-
-def render_pair(npz_a, npz_b, png_a, png_b):
-    """Re-render two figures of a thesis pair with one stress scale per non-damage panel."""
-    return render_shared([npz_a, npz_b], [png_a, png_b])
-
-
-def render_shared(npzs, pngs):
-    """Re-render figures of one run or one thesis pair with one scale per non-damage panel
-    (a stress that has nearly vanished then reads as such, not as a stress field of its own)."""
-    loaded = [load_panels(n)[0] for n in npzs]
-    limits = {}
-    for i in range(min(len(p) for p in loaded)):
-        if not any(is_damage(p[i]["name"], p[i]["label"]) for p in loaded):
-            limits[i] = shared_limits([p[i]["values"] for p in loaded])
-    return [render_saved(n, png, limits) for n, png in zip(npzs, pngs)]
-
-
-# ---------------------------------------------------------------------------- setting figures
-LOAD_COLOURS = {"f_N": "tab:purple", "f_B": "tab:orange"}
-
-
-def inside_test(cells):
-    """``inside(points) -> bool array``: points inside the body whose triangles are ``cells``."""
-    import matplotlib.tri as mtri
-    pts, inverse = np.unique(np.round(np.asarray(cells).reshape(-1, 2), 10), axis=0,
-                             return_inverse=True)
-    finder = mtri.Triangulation(pts[:, 0], pts[:, 1], inverse.reshape(-1, 3)).get_trifinder()
-    return lambda p: finder(np.asarray(p)[:, 0], np.asarray(p)[:, 1]) >= 0
-
-
-def body_force_points(cells, spacing):
-    """Points of a regular grid of step ``spacing`` inside the body (where the body-force
-    arrows sit); for thin bodies that the grid misses, one cell centroid per square."""
-    cells = np.asarray(cells)
-    pts = cells.reshape(-1, 2)
-    lo, hi = pts.min(0), pts.max(0)
-    gx, gy = (np.arange(lo[i] + spacing / 2, hi[i], spacing) for i in range(2))
-    grid = np.stack([g.ravel() for g in np.meshgrid(gx, gy)], 1)
-    grid = grid[inside_test(cells)(grid)]
-    if len(grid) >= 4:
-        return grid
-    centroids = cells.mean(1)
-    return centroids[spread(centroids, spacing / 2)]
-
-
-def draw_arrows(ax, tails, deltas, colour, label, size):
-    if not len(tails):
-        return
-    for i, (p, d) in enumerate(zip(tails, deltas)):
-        ax.annotate("", xy=p + d, xytext=p, zorder=4,
-                    arrowprops=dict(arrowstyle="-|>", color=colour, lw=1.1,
-                                    mutation_scale=8 + 4 * min(1.0, np.linalg.norm(d) / (3 * size))))
-    ax.plot([], [], color=colour, lw=1.1, marker=">", markersize=4, label=label)  # legend entry
-
-
-def _split_parts(parts, split):
-    """Boundary parts divided where a quantity changes along them (``split``: {label: (name,
-    function of the segment midpoints)}), e.g. the two friction planes of one contact part."""
-    out = []
-    for segs, colour, label, hatched in parts:
-        if not split or label not in split or segs.size == 0:
-            out.append((segs, colour, label, hatched))
-            continue
-        name, fn = split[label]
-        values = np.asarray(fn(segs.mean(1)), float)
-        for i, v in enumerate(np.unique(values)):
-            out.append((segs[values == v], colour, f"{label}, {name} = {v:g}", hatched,
-                        ("solid", "dashed", "dotted")[i % 3]))
-    return out
-
-
-def _free_edges(cells, parts):
-    """Outline edges of the mesh that no boundary part covers: traction-free."""
-    edges = boundary_edges(np.asarray(cells))
-    if not len(edges):
-        return edges
-    covered = [p[0].reshape(-1, 2, 2) for p in parts if p[0].size]
-    if not covered:
-        return edges
-    key = lambda segs: {tuple(sorted((tuple(np.round(a, 7)), tuple(np.round(b, 7)))))  # noqa: E731
-                        for a, b in segs}
-    taken = set().union(*(key(c) for c in covered))
-    return np.array([e for e in edges if tuple(sorted((tuple(np.round(e[0], 7)),
-                                                       tuple(np.round(e[1], 7))))) not in taken])
-
-
-def draw_setting(ax, cells, parts, loads=(), note="", split=None):
-    """A thesis setting figure: the undeformed mesh, boundary parts (``parts``: (segments,
-    colour, label, hatched)), load arrows (``loads``: ("f_N", segments, vectors, label) or
-    ("f_B", points, vectors, label)); frames the axes on body, markers and arrows; ``note``
-    (e.g. why a load is not drawn) goes under the legend. Outline edges no part covers are
-    drawn as traction-free; ``split`` divides a part where a quantity changes along it."""
-    from matplotlib.collections import LineCollection
-    cells = np.asarray(cells)
-    triangle_edges(ax, cells, colour="0.6", zorder=1,
-                              linewidth=0.3 if len(cells) > 3000 else 0.5)
-    size = 0.025 * max(np.ptp(cells.reshape(-1, 2), axis=0))
-    inside = inside_test(cells)
-    extent = [cells.reshape(-1, 2) + s for s in (-2 * size, 2 * size)]
-    free = _free_edges(cells, parts)
-    if len(free):
-        ax.add_collection(LineCollection(free, colors="k", linewidths=1.4,  # solid: dashes
-                                         label="traction-free boundary", zorder=3))  # restart per facet
-    for segs, colour, label, hatched, *style in _split_parts(parts, split):
-        if segs.size == 0:
-            continue
-        ax.add_collection(LineCollection(segs, colors=colour, linewidths=2.2,
-                                         linestyles=style[0] if style else "solid",
-                                         label=mathtext(label), zorder=3))
-        if hatched:
-            ax.add_collection(LineCollection(support_hatch(segs, inside, size), colors=colour,
-                                             linewidths=0.8, zorder=3))
-    for kind, where, vectors, label in loads:
-        where, vectors = np.asarray(where, float), np.asarray(vectors, float)
-        if kind == "f_N":
-            tails, deltas = traction_arrows(where, vectors, inside, size)
-        else:
-            norm = np.linalg.norm(vectors, axis=1)
-            deltas = 2.5 * size * vectors / max(norm.max(initial=0.0), 1e-300)
-            tails = where - deltas / 2
-        draw_arrows(ax, tails, deltas, LOAD_COLOURS[kind], label, size)
-        extent += [tails, tails + deltas]
-    _frame(ax, extent)
-    legend_below(ax, ncol=2)
-    if note:
-        ax.annotate(note, xy=(0.5, 0.0), xycoords="axes fraction", xytext=(0, -62),
-                    textcoords="offset points", ha="center", va="top", fontsize=7.5,
-                    color="0.3")
 
 
 def log_tick_labels(ax):
@@ -521,6 +365,12 @@ def log_tick_labels(ax):
         axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
+def LineCollection(segments, **kwargs):
+    """matplotlib's LineCollection of ``segments`` (imported on first use)."""
+    from matplotlib.collections import LineCollection as collection
+    return collection(segments, **kwargs)
+
+
 def legend_below(ax, ncol=3):
     """Legend under the axes' x label (never over the mesh), at a fixed distance in points
     whatever the axes' height."""
@@ -532,9 +382,27 @@ def legend_below(ax, ncol=3):
                   fontsize=8, frameon=False)
 
 
+def _tight(fig):
+    return fastdraw.tight_bbox(fig, plt().rcParams["savefig.pad_inches"])
+
+
 def save(fig, path, title=None):
     fig.tight_layout()
     if title:
         suptitle_on_top(fig, title)
-    fig.savefig(path, dpi=DPI, bbox_inches="tight")
+    fig.savefig(path, dpi=DPI, bbox_inches=_tight(fig), **fastdraw.png_options(path))
     plt().close(fig)
+
+
+#: names defined in figpanels.py and figsetting.py, reached through this module too
+_ELSEWHERE = {**dict.fromkeys(("save_panels", "load_panels", "render_saved", "render_pair",
+                               "render_shared"), "figpanels"),
+              **dict.fromkeys(("LOAD_COLOURS", "inside_test", "body_force_points", "draw_arrows",
+                               "_split_parts", "_free_edges", "draw_setting"), "figsetting")}
+
+
+def __getattr__(name):
+    if name in _ELSEWHERE:  # imported on first use: those modules import this one
+        import importlib
+        return getattr(importlib.import_module(f"{__package__}.{_ELSEWHERE[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

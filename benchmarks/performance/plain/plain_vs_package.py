@@ -4,7 +4,8 @@ processes in turn (script, package, script, ...), the package with its default o
 
     python benchmarks/performance/plain/plain_vs_package.py 3.1-ex1 [--pairs 3] [--out DIR]
 
-Problems with a script here: 2.1-ex1 (n = 160, k = 0.01), 3.1-ex1 (n = 128, k = 0.005). Prints
+Problems with a script here (the sizes of the comparison): 2.1-ex1 (n = 160, k = 0.01), 3.1-ex1
+(n = 128, k = 0.005), 2.2-ex1, 2.3-ex1, 2.4-ex1, 3.2-ex1, 3.3-ex1 (n = 64, k = 0.002). Prints
 the wall time of each process, the median ratio script / package (the package's speed-up) and
 the relative difference of the final u and zeta."""
 import argparse
@@ -19,7 +20,11 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 from compare import main as compare  # noqa: E402
 
-CASES = {"2.1-ex1": ("elastic_2_1.py", 160, 0.01), "3.1-ex1": ("dynamic_3_1.py", 128, 0.005)}
+CASES = {"2.1-ex1": ("elastic_2_1.py", 160, 0.01), "2.2-ex1": ("kelvin_voigt_2_2.py", 64, 0.002),
+         "2.3-ex1": ("memory_2_3.py", 64, 0.002), "2.4-ex1": ("viscoplastic_2_4.py", 64, 0.002),
+         "3.1-ex1": ("dynamic_3_1.py", 128, 0.005),
+         "3.2-ex1": ("dynamic_tresca_3_2.py", 64, 0.002),
+         "3.3-ex1": ("fully_damageable_3_3.py", 64, 0.002)}
 
 
 def wall(cmd):

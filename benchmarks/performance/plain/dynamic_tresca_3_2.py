@@ -1,0 +1,49 @@
+"""3.2 Ex. 1 written the straightforward way, to time the package against: the same discrete
+problem (the package's UFL forms, mesh and data), a plain DOLFINx time loop.
+
+    python benchmarks/performance/plain/dynamic_tresca_3_2.py --n 64 --k 0.002 --out DIR
+
+Per step (3.94)-(3.96): the damage obstacle step by SNES vinewtonrsls with bounds [zeta_star, 1];
+the velocity step with inertia, viscosity and friction implicit, v.nu = 0 on Gamma_C (y = 0, so
+v_2 = 0 there), Tresca friction regularised as g clip(v_1/eps, -1, 1), eps = eps_reg, vertex
+rule on Gamma_C, by a plain SNES Newton from v_{n-1}; u_n = u_{n-1} + k v_n. Outputs: u, v, zeta
+in an XDMF file every N/20 steps, ||u||_L2, ||v||_L2, min zeta per step in history.csv, the
+final u, zeta in final.npz."""
+import ufl
+from dolfinx import fem
+
+from common import Outputs, Setting, newton, obstacle_damage
+from damage_dolfinx.forms.dynamic_tresca import velocity_step_forms
+from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.laws import thesis_law
+from damage_dolfinx.numerics.constitutive import eps
+
+s = Setting("3.2-ex1", 64, 0.002, "plain_3_2")
+p, x_ = s.p, s.x_
+u, u_old, v, v_old = (fem.Function(s.V, name=n) for n in ("u", "u_old", "v", "v_old"))
+zeta, zeta_old = fem.Function(s.Z, name="zeta"), fem.Function(s.Z)
+zeta.x.array[:] = 1.0
+
+damage = obstacle_damage(s, zeta, zeta_old, thesis_law(p.variant)(eps(u_old), zeta_old, p))
+
+w = ufl.TestFunction(s.V)
+a, l = velocity_step_forms(v, w, v_old, u_old, zeta_old, float(x_["rho"]), s.k, p.E, p.nu,
+                           x_["m_visc"], p.L_trunc, p.zeta_star, s.body_force(), s.traction(),
+                           s.ds(GAMMA_N))
+g, e = s.const(x_["g_fric"]), s.const(x_["eps_reg"])
+ds_nodal = s.ds(GAMMA_C, metadata={"quadrature_rule": "GLL", "quadrature_degree": 1})
+friction = g * ufl.max_value(-1.0, ufl.min_value(1.0, v[0] / e)) * w[0] * ds_nodal
+velocity = newton(a - l + friction, v, [s.clamped(GAMMA_D), s.normal_zero(GAMMA_C, 1)],
+                  "friction_")
+
+out = Outputs(s, (u, v, zeta), {"u": u, "v": v}, zeta)
+for step in range(1, s.N + 1):
+    s.t_c.value = step * s.k
+    u_old.x.array[:] = u.x.array
+    v_old.x.array[:] = v.x.array
+    zeta_old.x.array[:] = zeta.x.array
+    damage()                                                # (3.94)
+    velocity()                                              # (3.95), from v_{n-1}
+    u.x.array[:] = u_old.x.array + s.k * v.x.array          # (3.96)
+    out.step(step)
+out.close(u, s.N)

@@ -1,0 +1,91 @@
+"""Command line: ``damage-dolfinx list | run ID | converge ID | sweep ID`` (works unchanged under
+mpirun).
+
+Single-dash options are PETSc options of the package's solvers (``-mech_ksp_type cg``,
+``-damage_snes_monitor``; prefixes PETSC_PREFIXES): any other single-dash word is refused with
+the double-dash option it resembles, a value PETSc refuses is refused before any work, and an
+option no solver read is named in a warning at the end. User errors print one line on rank 0
+and exit with status 2; a solver
+that does not converge or fails, or a state that is not finite or leaves [zeta_star, 1], exits
+with status 3 after writing what was finished (summary.json "failed"); an output error
+(disk full, I/O error, output folder deleted) exits with status 4; SIGTERM, SIGINT or SIGUSR1
+stop a run at the end of the current step with a checkpoint, exit status 128 + signal number
+(143, 130, 138); a repeat of the signal within 5 s is ignored, a later one ends the process
+at once (signals.StopSignals). Outside a run's time loop (set-up, a convergence study, a sweep
+between points) SIGTERM and SIGINT stop the command with one line, the status recorded and the
+same exit status. Any other exception (the user's own code) is one line, exit status 3. Under
+MPI every rank ends with the same status, also when only one rank failed
+(runtime/collective.py).
+"""
+from __future__ import annotations
+
+import os
+import sys
+
+from mpi4py import MPI
+
+# the parts, by concept: the arguments (arguments.py), the PETSc options among them
+# (petsc_options.py), what each command does (commands.py); these names are their public face
+from damage_dolfinx.cli.commands import command
+from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser  # noqa: F401
+from damage_dolfinx.cli.petsc_options import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401
+                                              _check_petsc_values, _forget, _petsc_options,
+                                              _unused)
+
+
+def main(argv=None):
+    """The command; every rank returns the same exit status (runtime/collective.py: an
+    exception on one rank only becomes one decided outcome, or ends the job)."""
+    import signal
+    from damage_dolfinx.runtime.signals import stop_outside_runs
+    comm = MPI.COMM_WORLD
+    given = {}
+    before = {}
+    try:
+        for s in (signal.SIGTERM, signal.SIGINT):  # the run's loop has its own (StopSignals)
+            before[s] = signal.signal(s, stop_outside_runs)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        return _main(argv, comm, given)
+    finally:
+        for s, handler in before.items():
+            if signal.getsignal(s) is stop_outside_runs:  # (an interruption leaves SIG_IGN)
+                signal.signal(s, handler)
+
+
+def _main(argv, comm, given):
+    from damage_dolfinx.runtime import collective
+    from damage_dolfinx.runtime.atomic import OutputError  # (runtime.io would load dolfinx)
+    from damage_dolfinx.runtime.signals import RunInterrupted
+    try:
+        with collective.outcome(comm):
+            try:
+                return command(argv, comm, given)
+            finally:
+                _forget(given)
+    except OutputError as exc:
+        _say(comm, collective.line(exc))
+        from damage_dolfinx.runtime.io import FAILED_HDF5_FILES
+        if FAILED_HDF5_FILES:  # HDF5 would crash shutting down the failed file
+            sys.stdout.flush()
+            comm.Barrier()
+            os._exit(4)
+        return 4
+    except (RunInterrupted, KeyboardInterrupt, collective.RankFailure) as exc:
+        import signal
+        from damage_dolfinx.runtime.signals import STOP_SIGNALS
+        if not isinstance(exc, collective.RankFailure) or exc.kind == "":
+            for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out
+                signal.signal(s, signal.SIG_IGN)
+        _say(comm, collective.line(exc))
+        return collective.classify(exc)[0]
+    except Exception as exc:  # noqa: BLE001 - input, solver, user code: one line, its status
+        _say(comm, collective.line(exc))
+        return collective.classify(exc)[0]
+
+
+def _say(comm, text):
+    if comm.rank == 0:
+        from damage_dolfinx.errors import for_command_line
+        print(for_command_line(text), file=sys.stderr, flush=True)

@@ -1,0 +1,117 @@
+"""Function spaces, element queries and interpolation.
+
+Version-specific calls only (damage_dolfinx.compat); imported from there."""
+from __future__ import annotations
+
+import numpy as np
+import ufl
+import ffcx
+import dolfinx
+from dolfinx import fem
+
+
+def function_space(msh, family: str, degree: int, shape: tuple = ()):
+    """Lagrange/DG space with value shape () (scalar), (gdim,) (vector) or (gdim, gdim)."""
+    if hasattr(fem, "functionspace"):  # 0.7+
+        return fem.functionspace(msh, (family, degree, shape) if shape else (family, degree))
+    cell = msh.ufl_cell()
+    if shape == ():
+        return fem.FunctionSpace(msh, (family, degree))
+    if len(shape) == 1:
+        return fem.FunctionSpace(msh, ufl.VectorElement(family, cell, degree, dim=shape[0]))
+    return fem.FunctionSpace(msh, ufl.TensorElement(family, cell, degree, shape=shape))
+
+
+def element_degree(V) -> int:
+    """Polynomial degree of V's element (a method of the legacy UFL element, a property of
+    basix.ufl elements from 0.7 on)."""
+    d = V.ufl_element().degree
+    return int(d() if callable(d) else d)
+
+
+def is_discontinuous(V) -> bool:
+    """True for DG spaces (legacy UFL: family 'Discontinuous Lagrange'; basix.ufl: a flag)."""
+    e = V.ufl_element()
+    flag = getattr(e, "discontinuous", None)
+    if isinstance(flag, bool):
+        return flag
+    family = e.family() if callable(getattr(e, "family", None)) else str(getattr(e, "family_name", ""))
+    return "Discontinuous" in family or family in ("DG", "DP")
+
+
+def scalar_p1(msh):
+    return function_space(msh, "Lagrange", 1)
+
+
+def vector_p1(msh):
+    """P1 vectors with one component per space dimension (2 on every thesis mesh, 3 in 3-D)."""
+    return function_space(msh, "Lagrange", 1, (msh.topology.dim,))
+
+
+def scalar_dg0(msh):
+    return function_space(msh, "DG", 0)
+
+
+def tensor_dg0(msh):
+    d = msh.topology.dim
+    return function_space(msh, "DG", 0, (d, d))
+
+
+def facet_vertex_quadrature() -> dict:
+    """Integration metadata of the vertex rule on the triangular facets of a tetrahedral mesh
+    (nodal quadrature of a 3-D boundary integral). FFCx 0.9+ applies its "vertex"
+    scheme to the facet; FFCx 0.5 applies it to the cell (tetrahedron points on a facet) and
+    Basix has no GLL rule on triangles, so there the rule is given explicitly: weight 1/6 (a
+    third of the reference triangle's area) at each vertex."""
+    major, minor = (int(part) for part in ffcx.__version__.split(".")[:2])
+    if (major, minor) >= (0, 9):
+        return {"quadrature_rule": "vertex", "quadrature_degree": 1}
+    return {"quadrature_rule": "custom", "quadrature_degree": 1,
+            "quadrature_points": ((0.0, 0.0), (1.0, 0.0), (0.0, 1.0)),
+            "quadrature_weights": (1.0 / 6.0,) * 3}
+
+
+def interpolation_points(V):
+    pts = V.element.interpolation_points
+    return pts() if callable(pts) else pts
+
+
+def expression(expr, V):
+    """A compiled fem.Expression of ``expr`` at the interpolation points of V."""
+    return fem.Expression(expr, interpolation_points(V))
+
+
+def eval_expression(expr, msh, cells):
+    """Values of a compiled fem.Expression at its points in the given local cells
+    (``eval(cells)`` up to 0.8, ``eval(mesh, cells)`` from 0.9 on)."""
+    cells = np.asarray(cells, dtype=np.int32)
+    try:
+        return expr.eval(msh, cells)
+    except TypeError:
+        return expr.eval(cells)
+
+
+def interpolate(u: fem.Function, source):
+    """u <- interpolant of a Python callable, a fem.Expression or a Function on the same mesh."""
+    u.interpolate(source)
+    u.x.scatter_forward()
+
+
+def locate_points(msh, points):
+    """Index of a local cell (owned or ghost) containing each point of ``points`` (N, 3),
+    -1 where none does (``BoundingBoxTree`` + ``compute_collisions`` up to 0.8, ``bb_tree`` +
+    ``compute_collisions_points`` from 0.9 on)."""
+    import dolfinx.geometry as geo
+    points = np.ascontiguousarray(points, dtype=msh.geometry.x.dtype)
+    tdim = msh.topology.dim
+    if hasattr(geo, "bb_tree"):
+        candidates = geo.compute_collisions_points(geo.bb_tree(msh, tdim), points)
+    else:
+        candidates = geo.compute_collisions(geo.BoundingBoxTree(msh, tdim), points)
+    colliding = geo.compute_colliding_cells(msh, candidates, points)
+    cells = np.full(len(points), -1, dtype=np.int32)
+    for i in range(len(points)):
+        links = colliding.links(i)
+        if len(links):
+            cells[i] = links[0]
+    return cells

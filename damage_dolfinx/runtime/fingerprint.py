@@ -1,0 +1,227 @@
+"""The fingerprint of a run: everything that defines it besides its time grid and parameters
+(those are compared as settings), checked by every resume (a run's restart, a sweep point's,
+each level of a convergence study's).
+
+Each item is partition-independent and canonical, so the same problem gives the same
+fingerprint on any number of ranks, under any Python hash seed, whatever else the process made
+before it. Loads and laws are compared by a canonical hash of the UFL they build, not by UFL's
+own signature: UFL orders the operands of a sum or a product by the text of their terminals,
+in which a constant carries its creation count (``Constant(..., 13)`` sorts before
+``Constant(..., 6)``), so the same code gave another signature in a process that had made more
+UFL objects before. Here
+
+    hash(terminal) = its kind, shape and rank among the terminals of its kind by creation
+                     order (constants, functions, labels, indices); numbers by value;
+                     geometric quantities by name (the mesh is its own item);
+    hash(operator) = its type and its operands' hashes, sorted for a sum or a product,
+
+plus the values UFL's signature leaves out: those of constants and a digest of functions'.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+
+import numpy as np
+from mpi4py import MPI
+
+from damage_dolfinx.parameters import InputError
+from damage_dolfinx.runtime import io
+
+#: the fingerprint's format: the loads' and laws' hashes of another version are not compared
+VERSION = 2
+
+#: how the items of the fingerprint are named in a refusal (in the order they are compared)
+ITEMS = {"mesh": "the mesh", "traction": "the traction", "body_force": "the body force",
+         "damage_law": "the damage law", "zeta0": "the initial damage zeta0",
+         "boundaries": "the boundary parts", "irreversible": "irreversibility",
+         "reading": "the reading", "builders": "the model's own data (builders)"}
+#: items hashed from UFL (compared only between fingerprints of the same VERSION)
+UFL_ITEMS = ("traction", "body_force", "damage_law")
+
+
+def fingerprint(ex, data) -> dict:
+    """The fingerprint of the run of ``ex`` on ``data`` (the problem on its mesh, Problem.problem_data): the mesh
+    (cells, vertices, bounding box, facet tags by count), the loads and the damage law by the
+    canonical hash of the UFL they build on this mesh (their literals and constants' values
+    included: a traction 100 times larger changes it), the initial damage, the boundary parts,
+    irreversibility, the reading and the model's own data (builders). Collective on the mesh's
+    ranks."""
+    import ufl
+    from dolfinx import fem
+    from damage_dolfinx.meshes import tag_counts
+    msh = data.geometry.mesh
+    comm = msh.comm
+    tdim, gdim = msh.topology.dim, msh.geometry.dim
+    x_local = msh.geometry.x[:, :gdim]
+    lo = np.array(x_local.min(axis=0) if len(x_local) else np.full(gdim, np.inf), dtype=float)
+    hi = np.array(x_local.max(axis=0) if len(x_local) else np.full(gdim, -np.inf), dtype=float)
+    comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
+    out = {"version": VERSION,
+           "mesh": f"{msh.topology.index_map(tdim).size_global} cells, "
+                   f"{msh.topology.index_map(0).size_global} vertices, box "
+                   f"{np.round(lo, 9).tolist()}-{np.round(hi, 9).tolist()}, tags "
+                   f"{sorted(tag_counts(data.geometry).items())}"}
+    x = ufl.SpatialCoordinate(msh)
+    t = fem.Constant(msh, 0.0)
+    for name in ("traction", "body_force"):
+        fn = getattr(data, name)
+        out[name] = None if fn is None else ufl_hash(fn(x, t))
+    law = data.damage_law or _thesis_law(data.params)
+    e, z = ufl.sym(ufl.outer(x, x)), x[0] * 0 + t + 1.0
+    out["damage_law"] = f"{getattr(law, 'name', '?')} {ufl_hash(law(e, z, data.params))}"
+    z0 = data.zeta0
+    if callable(z0):
+        pts = np.ascontiguousarray(msh.geometry.x.T)
+        values = np.asarray(z0(pts[:gdim] if gdim < 3 else pts), dtype=float).reshape(-1)
+        digest = [comm.allreduce(float(values.min()) if values.size else np.inf, op=MPI.MIN),
+                  comm.allreduce(float(values.max()) if values.size else -np.inf, op=MPI.MAX)]
+        out["zeta0"] = f"function of x in [{digest[0]:.9g}, {digest[1]:.9g}]"
+    else:
+        out["zeta0"] = float(z0)
+    out["boundaries"] = repr(sorted((str(k), _tags(v))
+                                    for k, v in (ex.boundaries or {}).items()))
+    out["irreversible"] = bool(data.irreversible)
+    out["reading"] = getattr(ex, "reading", None)
+    out["builders"] = repr(sorted((str(k), repr(v) if not callable(v) else "function")
+                                  for k, v in (data.builders or {}).items()))
+    return json.loads(io.strict_json(out))
+
+
+def first_difference(saved, now):
+    """(item, saved value, this value) of the first item of ITEMS that differs between two
+    fingerprints, or None. A fingerprint of another VERSION is compared on the items that do
+    not come from UFL."""
+    if not isinstance(saved, dict) or not isinstance(now, dict):
+        return None
+    same_version = saved.get("version", 1) == now.get("version", 1)
+    for key in ITEMS:
+        if key in UFL_ITEMS and not same_version:
+            continue
+        if key in saved and saved.get(key) != now.get(key):
+            return key, saved.get(key), now.get(key)
+    return None
+
+
+def verify_fingerprint(ex, stepper, meta, out) -> dict:
+    """The run's fingerprint; on a resume (``meta``: the checkpoint's metadata) InputError with
+    one line naming the first item that differs from the checkpoint's."""
+    fp = fingerprint(ex, stepper.data)
+    differ = first_difference((meta or {}).get("fingerprint"), fp)
+    if differ:
+        key, saved, now = differ
+        raise InputError(f"cannot restart: {ITEMS[key]} differs from the run in "
+                         f"{str(out)!r} (checkpoint: {saved!r}, this run: {now!r}); choose "
+                         "another --out to run it")
+    return fp
+
+
+# ---------------------------------------------------------------------------- canonical UFL
+def ufl_hash(expr) -> str:
+    """A hash of the UFL expression ``expr`` that is the same in every process running the same
+    code (see the module's docstring); a non-UFL value (a number) by its text."""
+    from ufl.core.expr import Expr
+    if not isinstance(expr, Expr):
+        return repr(expr)
+    text = _canonical(expr) + "|" + _values_of(expr)
+    return hashlib.sha1(text.encode()).hexdigest()[:16]
+
+
+def _canonical(expr) -> str:
+    from ufl.classes import (Coefficient, Constant, FixedIndex, GeometricQuantity, Index,
+                             Label, MultiIndex, Product, Sum, Zero)
+    from ufl.corealg.traversal import unique_pre_traversal
+    nodes = list(unique_pre_traversal(expr))
+    ranks = {}
+    for kind in (Constant, Coefficient, Label):
+        found = sorted({n for n in nodes if isinstance(n, kind)}, key=_count)
+        ranks.update((n, i) for i, n in enumerate(found))
+    indices = sorted({i for n in nodes if isinstance(n, MultiIndex) for i in n.indices()
+                      if isinstance(i, Index)}, key=_count)
+    index_rank = {i: r for r, i in enumerate(indices)}
+    memo = {}
+
+    def walk(node) -> str:
+        key = id(node)
+        if key in memo:
+            return memo[key][1]
+        if isinstance(node, MultiIndex):
+            text = "MI(" + ",".join(f"i{index_rank[i]}" if isinstance(i, Index) else
+                                    f"f{int(i)}" if isinstance(i, FixedIndex) else repr(i)
+                                    for i in node.indices()) + ")"
+        elif isinstance(node, (Constant, Coefficient)):
+            element = node.ufl_element() if isinstance(node, Coefficient) else None
+            text = (f"{type(node).__name__}{node.ufl_shape}#{ranks[node]}"
+                    + (f"[{element}]" if element is not None else ""))
+        elif isinstance(node, Label):
+            text = f"L{ranks[node]}"
+        elif isinstance(node, Zero):
+            text = f"Zero{node.ufl_shape}/{len(node.ufl_free_indices)}"
+        elif isinstance(node, GeometricQuantity):
+            text = type(node).__name__
+        elif node._ufl_is_terminal_:
+            text = repr(node)  # numbers, identities: no creation count in their text
+        else:
+            parts = [walk(op) for op in node.ufl_operands]
+            if isinstance(node, (Sum, Product)):
+                parts.sort()
+            text = f"{type(node).__name__}({','.join(parts)})"
+            if len(text) > 64:  # keep the texts short: a deep tree is hashed level by level
+                text = type(node).__name__ + ":" + hashlib.sha1(text.encode()).hexdigest()
+        memo[key] = (node, text)
+        return text
+
+    return walk(expr)
+
+
+def _count(obj) -> int:
+    for attr in ("count", "_count"):
+        value = getattr(obj, attr, None)
+        if callable(value):
+            value = value()
+        if isinstance(value, int):
+            return value
+    return 0
+
+
+def _values_of(expr) -> str:
+    """The values a symbolic hash leaves out, partition-independent, in the canonical order of
+    the terminals: those of constants (a load ``c * t`` with ``c`` a fem.Constant the user
+    changes; the time is a constant of value 0 here) and, for each function, its global size
+    and the sum of squares of its values (9 digits)."""
+    from ufl.classes import Coefficient, Constant
+    from ufl.corealg.traversal import unique_pre_traversal
+    nodes = list(unique_pre_traversal(expr))
+    parts = []
+    for c in sorted({n for n in nodes if isinstance(n, Constant)}, key=_count):
+        value = getattr(c, "value", None)
+        parts.append("c" + (np.array2string(np.round(np.asarray(value, dtype=float), 12))
+                            if value is not None else "?"))
+    for f in sorted({n for n in nodes if isinstance(n, Coefficient)}, key=_count):
+        x = getattr(f, "x", None)
+        if x is None:
+            parts.append("f?")
+            continue
+        V = f.function_space
+        owned = x.array[:V.dofmap.index_map.size_local * V.dofmap.index_map_bs]
+        comm = V.mesh.comm
+        size = comm.allreduce(len(owned), op=MPI.SUM)
+        squares = comm.allreduce(float(np.sum(np.abs(owned) ** 2)), op=MPI.SUM)
+        parts.append(f"f{size}:{squares:.9g}")
+    return ";".join(parts)
+
+
+def _thesis_law(params):
+    from damage_dolfinx.laws import thesis_law
+    return thesis_law(params.variant)
+
+
+def _tags(v):
+    """A boundary entry as the fingerprint holds it: a tag, a gmsh physical name, or a sorted
+    list of them (numbers as numbers, names as names)."""
+    if isinstance(v, (int, np.integer, str)):
+        return v if isinstance(v, str) else int(v)
+    if all(not isinstance(x, str) for x in v):
+        return sorted(map(int, v))
+    return sorted(map(str, v))
