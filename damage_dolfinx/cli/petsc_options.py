@@ -106,7 +106,9 @@ def _unused(given, comm):
     if any(u is None for u in used):
         return []
     import numpy as np  # (not at the top: --help loads no numpy)
-    used = comm.allreduce(np.array(used, dtype=np.int32), op=MPI.MAX) if names else []
+    used = np.array(used, dtype=np.int32)
+    if names:  # element-wise (the pickling allreduce compares whole arrays: two or more fail)
+        comm.Allreduce(MPI.IN_PLACE, used, op=MPI.MAX)
     return [f"-{n}" for n, u in zip(names, used) if not u]
 
 
