@@ -6,13 +6,20 @@ configuration; the last column is the relative difference to the first configura
 
     [mpirun -n 2] .venv/bin/python benchmarks/performance/solver_crossover_2d.py 2.1-ex1 720 mech chol_nd,gamg_def
 """
-import sys, time
+import argparse
+import time
+
 from mpi4py import MPI
 from petsc4py import PETSc
 from damage_dolfinx.catalogue import examples
 from damage_dolfinx.numerics import scalable
-ex_id, n = sys.argv[1], int(sys.argv[2])
-which = sys.argv[3] if len(sys.argv) > 3 else "mech"
+ap = argparse.ArgumentParser(description="direct against CG + AMG on one 2-D system of a run")
+ap.add_argument("example")
+ap.add_argument("n", type=int)
+ap.add_argument("system", nargs="?", default="mech", choices=("mech", "damage"))
+ap.add_argument("configs", nargs="?", default=None, help="comma-separated configuration names")
+args = ap.parse_args()
+ex_id, n, which = args.example, args.n, args.system
 comm = MPI.COMM_WORLD
 ex = examples.get(ex_id)
 k = 0.01 if ex_id.startswith("2.1") else 0.005
@@ -48,7 +55,7 @@ configs = {
  "gamg_rt8": {**scalable.MECH_AMG, "ksp_rtol": 1e-8},
  "cg_jacobi": {**base, "pc_type": "jacobi", "ksp_max_it": 20000},
 }
-only = sys.argv[4].split(",") if len(sys.argv) > 4 else list(configs)
+only = args.configs.split(",") if args.configs else list(configs)
 if which == "mech":
     A.setNearNullSpace(scalable.rigid_body_modes(V))
 x0 = b.duplicate()
