@@ -134,6 +134,14 @@ def obstacle_damage(s, zeta, zeta_old, phi):
     return solve
 
 
+def tresca_regularised(s, velocity, test, contact_tag):
+    """The regularised Tresca term g clip(v_1/eps, -1, 1) w_1 on Gamma_C, integrated at the
+    vertices (the tangential direction is x_1; v_2 = 0 there by a boundary condition)."""
+    g, e = s.const(s.x_["g_fric"]), s.const(s.x_["eps_reg"])
+    ds_nodal = s.ds(contact_tag, metadata={"quadrature_rule": "GLL", "quadrature_degree": 1})
+    return g * ufl.max_value(-1.0, ufl.min_value(1.0, velocity[0] / e)) * test[0] * ds_nodal
+
+
 def newton(F, u, bcs, prefix, rtol=1e-10, atol=1e-10):
     """A plain SNES Newton (newtonls, basic line search, MUMPS LU) on F(u; .) = 0 with its UFL
     Jacobian. Returns solve()."""

@@ -12,7 +12,7 @@ final u, zeta in final.npz."""
 import ufl
 from dolfinx import fem
 
-from common import Outputs, Setting, newton, obstacle_damage
+from common import Outputs, Setting, newton, obstacle_damage, tresca_regularised
 from damage_dolfinx.forms.dynamic_tresca import velocity_step_forms
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.laws import thesis_law
@@ -30,9 +30,7 @@ w = ufl.TestFunction(s.V)
 a, l = velocity_step_forms(v, w, v_old, u_old, zeta_old, float(x_["rho"]), s.k, p.E, p.nu,
                            x_["m_visc"], p.L_trunc, p.zeta_star, s.body_force(), s.traction(),
                            s.ds(GAMMA_N))
-g, e = s.const(x_["g_fric"]), s.const(x_["eps_reg"])
-ds_nodal = s.ds(GAMMA_C, metadata={"quadrature_rule": "GLL", "quadrature_degree": 1})
-friction = g * ufl.max_value(-1.0, ufl.min_value(1.0, v[0] / e)) * w[0] * ds_nodal
+friction = tresca_regularised(s, v, w, GAMMA_C)
 velocity = newton(a - l + friction, v, [s.clamped(GAMMA_D), s.normal_zero(GAMMA_C, 1)],
                   "friction_")
 

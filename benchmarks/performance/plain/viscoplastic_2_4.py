@@ -13,7 +13,7 @@ final.npz."""
 import ufl
 from dolfinx import fem
 
-from common import Outputs, Setting, newton, obstacle_damage
+from common import Outputs, Setting, newton, obstacle_damage, tresca_regularised
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.laws import thesis_law
@@ -35,9 +35,7 @@ sigma_expr = fem.Expression(stress_update(sigma_old, w, G_hat, k, p.E, p.nu), po
 v = ufl.TestFunction(s.V)
 a, l = increment_step_forms(w, v, sigma_old, G_hat, k, p.E, p.nu, s.body_force(), s.traction(),
                             s.ds(GAMMA_N))
-g, e = s.const(x_["g_fric"]), s.const(x_["eps_reg"])
-ds_nodal = s.ds(GAMMA_C, metadata={"quadrature_rule": "GLL", "quadrature_degree": 1})
-friction = g * ufl.max_value(-1.0, ufl.min_value(1.0, w[0] / e)) * v[0] * ds_nodal
+friction = tresca_regularised(s, w, v, GAMMA_C)
 increment = newton(a - l + friction, w, [s.clamped(GAMMA_D), s.normal_zero(GAMMA_C, 1)],
                    "friction_")
 damage = obstacle_damage(s, zeta, zeta_old, thesis_law(p.variant)(eps(u_old), zeta_old, p))
