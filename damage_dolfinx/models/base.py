@@ -72,7 +72,8 @@ class Model:
 
     Subclasses create ``self.u`` (displacement), ``self.zeta`` and ``self.zeta_old`` (damage)
     and ``self.von_mises`` (DG0), declare :meth:`scheme` (the sub-steps), implement
-    ``update_output()``, and list output fields in ``self.output_fields``. Hooks for problem-specific output: ``history_columns`` (keys that
+    ``update_output()``, and list output fields in ``self.output_fields``. Hooks for
+    problem-specific output: ``history_columns`` (keys that
     ``scalars()`` or the step stats add to history.csv; an instance may set
     ``extra_history_columns`` when they depend on the data) and ``summary_extra()`` (keys added
     to summary.json).

@@ -41,7 +41,8 @@ UFL_ITEMS = ("traction", "body_force", "damage_law")
 
 
 def fingerprint(ex, data) -> dict:
-    """The fingerprint of the run of ``ex`` on ``data`` (the problem on its mesh, Problem.problem_data): the mesh
+    """The fingerprint of the run of ``ex`` on ``data`` (the problem on its mesh,
+    Problem.problem_data): the mesh
     (cells, vertices, bounding box, facet tags by count), the loads and the damage law by the
     canonical hash of the UFL they build on this mesh (their literals and constants' values
     included: a traction 100 times larger changes it), the initial damage, the boundary parts,
