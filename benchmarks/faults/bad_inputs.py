@@ -660,6 +660,11 @@ def _api_cases(case, none, copy, only_user, mesh, run, conv, sweep_base):
     api("3 ranks: a load raising on rank 1 only", "mpi",
         "def load(x, t):\n    if MPI.COMM_WORLD.rank == 1:\n        raise RuntimeError('rank 1')\n"
         "    return ufl.as_vector((t, 0.0))\nrun(problem(traction=load))", fast=False, ranks=3)
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("bad_inputs_more", HERE / "bad_inputs_more.py")
+    more = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(more)
+    more.more_cases(case, api, globals(), none, copy, only_user, mesh, run, conv, sweep_base)
 
 
 def point_user_file(work, bases):
@@ -760,6 +765,9 @@ def classify(case, status, stderr, before, after, user, work) -> dict:
     elif status == 3 and len(ours) == 1 and summary.get("status") == "failed" and \
             summary.get("error"):
         outcome = "failed"
+    elif status in (130, 143) and len(ours) == 1 and summary.get("status", "interrupted") \
+            in ("interrupted", "stopped"):
+        outcome = "interrupted"
     elif status == 0 and any("warning" in line.lower() for line in ours):
         outcome = "warned"
     elif status == 0:
