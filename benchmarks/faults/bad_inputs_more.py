@@ -121,8 +121,9 @@ def more_cases(case, api, ns, none, copy, only_user, mesh, run, conv, sweep_base
     case("sweep --k 1e-12", "sweep",
          ["sweep", "2.1-ex1", "--n", "5", "--k", "1e-12", "--set", "kappa=1,2", "--out", OUT])
     api("sweep grid {}", "api", "dd.sweep(problem(), 'o', {})")
-    api("sweep grid {'kappa': 2.0} (not a list)", "api",
-        "dd.sweep(problem(), 'o', {'kappa': 2.0}, figures=False)")
+    api("sweep grid {'kappa': 2.0} (one value, as --set kappa=2)", "api",
+        "dd.sweep(problem(), 'o', {'kappa': 2.0}, figures=False, progress=False)", expect="ok",
+        fast=False)
     api("sweep grid {'kappa': []}", "api", "dd.sweep(problem(), 'o', {'kappa': []})")
     api("sweep grid with a non-text key", "api", "dd.sweep(problem(), 'o', {3: [1.0]})")
     api("sweep grid {'E': ['soft']}", "api", "dd.sweep(problem(), 'o', {'E': ['soft']})")
@@ -227,11 +228,22 @@ def more_cases(case, api, ns, none, copy, only_user, mesh, run, conv, sweep_base
     case("summary.json deleted, --restart", "restart", [*run, "--restart", "--out", OUT],
          run_edit(lambda f: (f / "summary.json").unlink()), "ok",
          verify=summary_check("completed", 4))
-    case("study's convergence.json cut short, converge --restart", "restart",
+    def table_whole(name):
+        def verify(work):
+            lines = (work / OUT / name).read_text().splitlines()
+            if len(lines) < 2 or len({line.count(",") for line in lines}) != 1:
+                return f"{name} left cut short ({len(lines)} line(s))"
+            return None
+        return verify
+    case("study's errors.csv cut short, converge --restart", "restart",
          [*conv, "--n", "5", "--k", "0.25", "0.5", "--restart", "--out", OUT],
-         run_edit(lambda f: (f / "convergence.json").write_text('{"le'), "study"), "ok",
-         fast=False, verify=lambda w: None if json.loads(
-             (w / OUT / "convergence.json").read_text()) else "convergence.json empty")
+         run_edit(lambda f: (f / "errors.csv").write_text(
+             (f / "errors.csv").read_text()[:150]), "study"), "ok", fast=False,
+         verify=table_whole("errors.csv"))
+    case("study's summary.json cut short, converge --restart", "restart",
+         [*conv, "--n", "5", "--k", "0.25", "0.5", "--restart", "--out", OUT],
+         run_edit(lambda f: (f / "summary.json").write_text('{"sche'), "study"), "ok",
+         fast=False, verify=summary_check("completed"))
 
     # ------------------------------------------------------------ 5. the API's bad input
     api("T=True (a flag)", "api", "run(problem(T=True))")

@@ -123,9 +123,10 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
     processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
-    from damage_dolfinx.validation import check_sweep
-    with outcome(comm):
-        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress)
+    from damage_dolfinx.validation import check_sweep, communicator
+    with outcome(communicator("comm", comm)):
+        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress,
+                              out, comm)
         layout = _check_layout(ranks_per_point, point, checked["max_points"], comm)
         return _sweep(problem, out, grid, comm=comm, **checked, **layout)
 
