@@ -125,6 +125,27 @@ def verify_fingerprint(ex, stepper, meta, out) -> dict:
     return fp
 
 
+def sweep_fingerprint(ex, out, n, k, T, values, comm) -> dict:
+    """The fingerprint shared by every point of a sweep (built at one point: the parameters are
+    compared as the grid); InputError naming the first item that changed when ``out`` holds
+    a sweep of an earlier fingerprint (its finished points would be kept as this sweep's)."""
+    from pathlib import Path
+    fp = fingerprint(ex, ex.problem_data(comm, n=n, k=k, T=T, overrides=dict(values)))
+    saved = None
+    if comm.rank == 0:
+        try:
+            saved = json.loads((Path(out) / "points.json").read_text()).get("fingerprint")
+        except (OSError, ValueError, AttributeError):
+            saved = None
+    differ = first_difference(comm.bcast(saved, root=0), fp)
+    if differ:
+        key, was, now = differ
+        raise InputError(f"cannot run the sweep into {str(out)!r}: {ITEMS[key]} changed since "
+                         f"its points were run (sweep: {was!r}, this sweep: {now!r}); choose "
+                         "another out folder")
+    return fp
+
+
 # ---------------------------------------------------------------------------- nodal digests
 def nodal_digest(comm, coords, values=None) -> str:
     """A hash of points (and values at them) that no partition changes: every rank's rows

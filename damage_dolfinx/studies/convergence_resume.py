@@ -72,6 +72,6 @@ def check_restart(previous, settings, out, ref_n):
             key, was, is_ = differ
             where = f"the reference mesh n = {level}" if level == str(ref_n) else \
                 f"the level n = {level}"
-            raise InputError(f"cannot restart: {ITEMS[key]} differs from the study in "
+            raise InputError(f"cannot restart: {ITEMS[key]} changed since the study in "
                              f"{str(out)!r} at {where} (study: {was!r}, this study: {is_!r}); "
                              "choose another out folder (or overwrite=True) to run it")
