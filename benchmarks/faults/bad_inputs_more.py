@@ -7,8 +7,28 @@ import subprocess
 import sys
 
 
-def more_cases(case, api, ns, none, copy, only_user, mesh, run, conv, sweep_base):
+#: the representative cases that also run in tests/test_bad_inputs.py (one or two of each
+#: mechanism: the rule per argument name, the Problem's data, the fingerprint, the summaries
+#: and outputs rebuilt from disk, the sweep folder)
+FAST = {"run(on_step=5)", "run(comm='world')", "steps(out=None)", "converge(progress='no')",
+        "sweep(out=None)", "read_mesh(comm='world')", "from_gmsh(model=42)", "params E=inf",
+        "zeta0(x) NaN at one node", "restart, zeta0(x) changed inside, same min and max",
+        "--restart -mech_ksp_rtol 1e-2 (a result-changing PETSc option)",
+        "restart, a traction tag given as [2] (the same run)",
+        "sweep restart, the traction changed", "summary.json binary garbage, --restart",
+        "study's errors.csv cut short, converge --restart",
+        "sweep again, a user's file in point_0/mine/"}
+
+
+def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_base):
     OUT = ns["OUT"]
+
+    def case(id_, *args, fast=None, **kw):
+        case_(id_, *args, fast=id_ in FAST, **kw)
+
+    def api(id_, *args, fast=None, **kw):
+        api_(id_, *args, fast=id_ in FAST, **kw)
+
     tiny = ["--n", "5", "--k", "0.25", "--no-figures", "--quiet"]
 
     def text_file(name, content):
