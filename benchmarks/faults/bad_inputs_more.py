@@ -17,7 +17,8 @@ FAST = {"run(on_step=5)", "run(comm='world')", "steps(out=None)", "converge(prog
         "restart, a traction tag given as [2] (the same run)",
         "sweep restart, the traction changed", "summary.json binary garbage, --restart",
         "study's errors.csv cut short, converge --restart",
-        "sweep again, a user's file in point_0/mine/"}
+        "sweep again, a user's file in point_0/mine/",
+        "on_step raising at step 1 (serial): the summary says failed"}
 
 
 def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_base):
@@ -65,6 +66,13 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
     # ------------------------------------------------------------ 1. one rank fails, all end
     raise_on = ("def boom(step):\n    if MPI.COMM_WORLD.rank == {r} and step.n == {n}:\n"
                 "        raise RuntimeError('rank {r} gives up')\n")
+    api("on_step raising at step 1 (serial): the summary says failed", "mpi",
+        raise_on.format(r=0, n=1) + "try:\n    run(problem(T=0.04), on_step=boom)\n"
+        "except RuntimeError as exc:\n    import gc, json\n    gc.collect()\n"
+        "    s = json.load(open('o/summary.json'))\n"
+        "    print(f'damage-dolfinx: failed: {exc} (summary: {s[\"status\"]})', "
+        "file=sys.stderr)\n    sys.exit(3 if s['status'] == 'failed' else 1)",
+        expect="failed")
     api("2 ranks: on_step raising on rank 1 mid-run", "mpi",
         raise_on.format(r=1, n=1) + "run(problem(T=0.04), on_step=boom)", expect="failed",
         fast=False, ranks=2)
