@@ -168,7 +168,40 @@ def _check_parameters_of(params, info, own_law):
 def check_data(data):
     """The loads, the damage law, the initial damage and the boundary parts against the mesh
     (called once the geometry exists, before any solver is set up): shapes from the UFL
-    expressions the user's functions build, evaluated symbolically."""
+    expressions the user's functions build, evaluated symbolically. The user's functions run on
+    each rank with no collective call in between; one exchange then decides for every rank (a
+    function that raises on one rank only is refused on all of them alike, nobody waits)."""
+    comm = data.geometry.mesh.comm
+    error, stats = None, (0, np.inf, -np.inf)
+    try:
+        stats = _local_checks(data)
+    except InputError as exc:
+        error = str(exc)
+    decided = comm.allgather((error, stats))
+    errors = [e for e, _ in decided if e is not None]
+    if errors:
+        raise InputError(errors[0])
+    if data.traction is not None:
+        from damage_dolfinx.meshes import tag_counts
+        from damage_dolfinx.models.registry import TRACTION
+        if not tag_counts(data.geometry).get(TRACTION):
+            raise InputError("traction is given but the mesh has no boundary part with the "
+                             f"traction role (tag {TRACTION}): name it in boundaries")
+    if callable(data.zeta0):
+        bad = sum(s[0] for _, s in decided)
+        lo, hi = min(s[1] for _, s in decided), max(s[2] for _, s in decided)
+        if bad:
+            raise InputError(f"zeta0(x) must be finite at every mesh node, got NaN or inf at "
+                             f"{bad} node(s)")
+        zs = data.params.zeta_star
+        if not (np.isfinite(lo) and np.isfinite(hi)) or lo < zs - 1e-12 or hi > 1.0 + 1e-12:
+            raise InputError(f"zeta0(x) must lie in [zeta_star, 1] = [{zs:g}, 1] at every mesh "
+                             f"node, got values in [{lo:.4g}, {hi:.4g}]")
+
+
+def _local_checks(data) -> tuple:
+    """check_data's work on this rank alone: the shapes of the loads and the law, zeta0(x) at
+    this rank's nodes; returns (non-finite count, min, max) of those values."""
     import ufl
     from damage_dolfinx.laws import THESIS_A, THESIS_B
     msh = data.geometry.mesh
@@ -182,12 +215,6 @@ def check_data(data):
         value = _call(name, "(x, t)", fn, x, t)
         _expect_shape(name, value, (gdim,), f"a UFL vector of {gdim} components "
                       f"(ufl.as_vector(({', '.join(['...'] * gdim)})))")
-    if data.traction is not None:
-        from damage_dolfinx.meshes import tag_counts
-        from damage_dolfinx.models.registry import TRACTION
-        if not tag_counts(data.geometry).get(TRACTION):
-            raise InputError("traction is given but the mesh has no boundary part with the "
-                             f"traction role (tag {TRACTION}): name it in boundaries")
     law = data.damage_law
     if law is not None and law not in (THESIS_A, THESIS_B):
         e = ufl.sym(ufl.outer(x, x))
@@ -195,29 +222,21 @@ def check_data(data):
         value = _call(f"damage_law {law.name!r}", "(eps, zeta, params)", law, e, z, data.params)
         _expect_shape(f"damage_law {law.name!r}", value, (), "a UFL scalar")
     z0 = data.zeta0
-    if callable(z0):  # at the mesh nodes, where the P1 interpolation takes it
-        from mpi4py import MPI
-        pts = np.ascontiguousarray(msh.geometry.x.T)
-        pts = pts[:gdim] if gdim < 3 else pts
-        try:
-            values = np.asarray(z0(pts), dtype=float)
-        except Exception as exc:  # noqa: BLE001 - a user function: named, one line
-            raise InputError(f"zeta0(x) raised {type(exc).__name__}: {exc} (x: a NumPy array of "
-                             f"shape ({gdim}, N))") from None
-        if values.shape not in ((pts.shape[1],), (1, pts.shape[1])):
-            raise InputError(f"zeta0(x) must return one value per point (shape (N,)), got "
-                             f"shape {values.shape} for N = {pts.shape[1]}")
-        comm = msh.comm
-        bad = comm.allreduce(int(np.count_nonzero(~np.isfinite(values))), op=MPI.SUM)
-        if bad:
-            raise InputError(f"zeta0(x) must be finite at every mesh node, got NaN or inf at "
-                             f"{bad} node(s)")
-        lo = comm.allreduce(float(np.min(values)) if values.size else np.inf, op=MPI.MIN)
-        hi = comm.allreduce(float(np.max(values)) if values.size else -np.inf, op=MPI.MAX)
-        zs = data.params.zeta_star
-        if not (np.isfinite(lo) and np.isfinite(hi)) or lo < zs - 1e-12 or hi > 1.0 + 1e-12:
-            raise InputError(f"zeta0(x) must lie in [zeta_star, 1] = [{zs:g}, 1] at every mesh "
-                             f"node, got values in [{lo:.4g}, {hi:.4g}]")
+    if not callable(z0):
+        return 0, np.inf, -np.inf
+    pts = np.ascontiguousarray(msh.geometry.x.T)  # the mesh nodes, where P1 takes zeta0
+    pts = pts[:gdim] if gdim < 3 else pts
+    try:
+        values = np.asarray(z0(pts), dtype=float)
+    except Exception as exc:  # noqa: BLE001 - a user function: named, one line
+        raise InputError(f"zeta0(x) raised {type(exc).__name__}: {exc} (x: a NumPy array of "
+                         f"shape ({gdim}, N))") from None
+    if values.shape not in ((pts.shape[1],), (1, pts.shape[1])):
+        raise InputError(f"zeta0(x) must return one value per point (shape (N,)), got "
+                         f"shape {values.shape} for N = {pts.shape[1]}")
+    finite = values[np.isfinite(values)]
+    return (int(values.size - finite.size), float(finite.min()) if finite.size else np.inf,
+            float(finite.max()) if finite.size else -np.inf)
 
 
 def _time_constant(msh):
