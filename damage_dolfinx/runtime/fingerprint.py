@@ -16,6 +16,11 @@ UFL objects before. Here
     hash(operator) = its type and its operands' hashes, sorted for a sum or a product,
 
 plus the values UFL's signature leaves out: those of constants and a digest of functions'.
+Nodal data (the mesh's node coordinates and cell midpoints, a zeta0(x)'s values) are hashed
+after gathering them on rank 0, duplicates (ghosts) removed and sorted by coordinates
+(``nodal_digest``): 1, 2 or 3 ranks give the same digest, so a restart on another number of
+ranks is accepted. The PETSc options the user gave to the package's solvers are an item too
+(their defaults, which depend on the number of ranks, and diagnostics are not).
 """
 from __future__ import annotations
 
@@ -47,11 +52,11 @@ _DIAGNOSTIC = ("monitor", "view", "converged_reason", "log", "test")
 def fingerprint(ex, data) -> dict:
     """The fingerprint of the run of ``ex`` on ``data`` (the problem on its mesh,
     Problem.problem_data): the mesh
-    (cells, vertices, bounding box, facet tags by count), the loads and the damage law by the
-    canonical hash of the UFL they build on this mesh (their literals and constants' values
-    included: a traction 100 times larger changes it), the initial damage, the boundary parts,
-    irreversibility, the reading and the model's own data (builders). Collective on the mesh's
-    ranks."""
+    (cells, vertices, bounding box, facet tags by count; a digest of its nodes and cells), the
+    loads and the damage law by the canonical hash of the UFL they build on this mesh (their
+    literals and constants' values included: a traction 100 times larger changes it), the initial damage, the boundary parts,
+    irreversibility, the reading, the model's own data (builders) and the PETSc options given.
+    Collective on the mesh's ranks."""
     import ufl
     from dolfinx import fem
     from damage_dolfinx.meshes import tag_counts
