@@ -190,7 +190,8 @@ def given_options() -> list:
     for name, value in PETSc.Options().getAll().items():
         if not name.startswith(PETSC_PREFIXES) or any(d in name for d in _DIAGNOSTIC):
             continue
-        if name in solvers._CODE_DEFAULTS and str(solvers._CODE_DEFAULTS[name]) == str(value):
+        if name in solvers._CODE_DEFAULTS and \
+                str(solvers._CODE_DEFAULTS[name]).lower() == str(value).lower():
             continue
         given.append([name, str(value)])
     return sorted(given)
