@@ -26,8 +26,9 @@ import re
 import numpy as np
 
 from . import fastdraw
-from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks, range_decimals,  # noqa: F401
-                        is_damage, narrow_damage, range_text, shared_limits, si_unit)
+from .figscales import (NARROW_DAMAGE, SI_PREFIXES, damage_limits, damage_ticks,  # noqa: F401
+                        range_decimals, is_damage, narrow_damage, range_text, shared_limits,
+                        si_unit)
 from .figtext import (THESIS_FACTORS, amplification_text, drawn_amplification,  # noqa: F401
                       error_mathtext, is_round, mathtext, round_amplification)
 from .figbody import (READABLE, RASTERISE_CELLS, _triangulation, boundary_edges,  # noqa: F401
@@ -148,7 +149,8 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
                 vmin, vmax = (limits or {}).get(i) or (0.0, float(np.nanmax(vals)) or 1.0)
                 cmap, label, note = STRESS_CMAP, mathtext(p.get("label", "")), ""
             im = draw_field(ax, tri, vals, cmap, vmin, vmax)
-            ticks = damage_ticks(vmin, vmax, zeta_star) if damage and zeta_star is not None else None
+            ticks = (damage_ticks(vmin, vmax, zeta_star) if damage and zeta_star is not None
+                     else None)
             label, scale = si_unit(label, vmax) if not damage else (label, 1.0)
             cb = colorbar(fig, ax, im, label, ticks)
             if not ticks:
