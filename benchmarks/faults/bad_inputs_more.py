@@ -393,13 +393,15 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
         expect="interrupted", fast=False)
     # SIGINT as an interactive session has it (a job started in the background ignores it)
     api("SIGINT while the load is built (set-up)", "signal",
-        "import os, signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\ndef load(x, t):\n    os.kill(os.getpid(), signal.SIGINT)\n"
+        "import os, signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "def load(x, t):\n    os.kill(os.getpid(), signal.SIGINT)\n"
         "    return ufl.as_vector((t, 0.0))\n"
         "try:\n    run(problem(traction=load))\nexcept KeyboardInterrupt:\n"
         "    print('damage-dolfinx: stopped by SIGINT', file=sys.stderr)\n    sys.exit(130)",
         expect="interrupted")
     api("SIGINT in converge at the coarse level", "signal",
-        "import os, signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\ncalls = []\ndef load(x, t):\n    calls.append(1)\n"
+        "import os, signal\nsignal.signal(signal.SIGINT, signal.default_int_handler)\n"
+        "calls = []\ndef load(x, t):\n    calls.append(1)\n"
         "    if len(calls) == 4:\n        os.kill(os.getpid(), signal.SIGINT)\n"
         "    return ufl.as_vector((10 * t, 0.0))\n"
         "try:\n    dd.converge(problem(traction=load), 'o', n=[2], k=[0.01], ref_n=4, "
