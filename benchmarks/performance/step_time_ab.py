@@ -69,6 +69,7 @@ def run(python, example, n, T, out, clock="cpu"):
 
 
 def bootstrap_median(ratios, resamples=10000, seed=0):
+    """2.5 and 97.5 percentiles of the median of ``ratios`` resampled with replacement."""
     rng = np.random.default_rng(seed)
     r = np.asarray(ratios)
     medians = np.median(r[rng.integers(0, len(r), (resamples, len(r)))], axis=1)
@@ -101,7 +102,8 @@ def measure(old, new, example, n, args, work):
         per["new"].append(got["new"])
         ratios.append(got["new"] / got["old"])
     lo, hi = bootstrap_median(ratios)
-    return {"example": example, "n": n, "clock": args.clock, "k": k, "steps_per_run": n_steps, "pairs": len(ratios),
+    return {"example": example, "n": n, "clock": args.clock, "k": k, "steps_per_run": n_steps,
+            "pairs": len(ratios),
             "old_median_step_s": float(np.median(per["old"])),
             "new_median_step_s": float(np.median(per["new"])),
             "ratio_new_old_median": float(np.median(ratios)), "ratio_ci95": [lo, hi],
