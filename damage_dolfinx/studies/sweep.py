@@ -123,9 +123,10 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
     processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
-    from damage_dolfinx.validation import check_sweep
-    with outcome(comm):
-        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress)
+    from damage_dolfinx.validation import check_sweep, communicator
+    with outcome(communicator("comm", comm)):
+        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress,
+                              out, comm)
         layout = _check_layout(ranks_per_point, point, checked["max_points"], comm)
         return _sweep(problem, out, grid, comm=comm, **checked, **layout)
 
@@ -166,6 +167,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     from damage_dolfinx.runtime.runfolder import RunLive
     from damage_dolfinx.runtime.runner import resolve
     from damage_dolfinx.runtime.runner import run as run_one
+    from damage_dolfinx.runtime.fingerprint import sweep_fingerprint
     from damage_dolfinx.studies.sweep_folder import open_sweep, record
 
     wall_start = time.perf_counter()
@@ -192,6 +194,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                "points": [{"index": i, "folder": f"point_{i}", "values": values}
                           for i, values in enumerate(points)],
                "shared": _shared(ex, grid)}
+    mapping["fingerprint"] = sweep_fingerprint(ex, out, n, k, T, points[0], comm)
     out = io.prepare_output_dir(out, comm)
     states = open_sweep(out, mapping, point, comm)
     if point is None:  # a job of one point leaves the sweep's status to the record (others run)
