@@ -31,6 +31,12 @@ A point whose ``summary.json`` says "completed" is kept as it is when the sweep 
 point that was interrupted reruns from its checkpoint with ``restart=True``, or from the
 start otherwise; a point live in another process is left to it.
 
+Every point is checked before any point runs, as ``run`` checks a run (its values, n, k, T
+and its mesh, built once per mesh size); a refusal names the point. The sweep's status in
+``summary.json`` is rebuilt from the points' records as each call ends, also a job of one point
+that ends early (``sweep_folder.settle``): "running" while a point is live in another process,
+else "failed", "completed" or "incomplete".
+
 Failures: a point that fails on every rank of its group (a solver, a refused value, an
 exception of user code raised alike) is recorded as failed and the sweep goes on (the
 sweep's status "failed", exit status 3 on the command line); an exception on some ranks of a
@@ -148,6 +154,21 @@ def _check_layout(ranks_per_point, point, max_points, comm) -> dict:
     return {"ranks_per_point": ranks, "point": point}
 
 
+def _check_point(ex, i, values, n, k, T, meshes, together, comm):
+    """Point ``i`` checked as ``run`` checks it before any work: its description
+    (``configure``) and its mesh, built once per mesh size on ``comm`` (a size the geometry
+    refuses, such as an n the hole does not fit, is refused here, before any point runs).
+    InputError naming the point otherwise; returns the point's mesh size (n, h)."""
+    try:
+        c = ex.configure(n, k, T, None, dict(values))
+        size = (c.n, c.h)
+        if not together and size not in meshes:
+            c.make_geometry(comm, *size)
+        return size
+    except InputError as exc:
+        raise InputError(f"point {i} ({_describe(values)}): {exc}") from None
+
+
 def _shared(ex, grid) -> dict:
     """What every point shares besides n, k, T (points.json "shared"): the model, the reading
     and the parameters not swept (those a file can hold: numbers, text, flags)."""
@@ -162,11 +183,9 @@ def _shared(ex, grid) -> dict:
 def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, progress,
            ranks_per_point, point, comm) -> dict:
     from damage_dolfinx.runtime import io
-    from damage_dolfinx.runtime.collective import classify, describe, mark, track
-    from damage_dolfinx.runtime.runfolder import RunLive
+    from damage_dolfinx.runtime.collective import track
     from damage_dolfinx.runtime.runner import resolve
-    from damage_dolfinx.runtime.runner import run as run_one
-    from damage_dolfinx.studies.sweep_folder import open_sweep, record
+    from damage_dolfinx.studies.sweep_folder import open_sweep, settle
 
     wall_start = time.perf_counter()
     grid = check_grid(grid)
@@ -182,8 +201,9 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     ranks = ranks_per_point or (size if together or point is not None else 1)
     ex = resolve(problem)
     checked_at = time.perf_counter()
+    meshes = set()
     for i in (range(len(points)) if point is None else [point]):  # checked before any work
-        ex.configure(n, k, T, None, dict(points[i]))
+        meshes.add(_check_point(ex, i, points[i], n, k, T, meshes, together, comm))
         if progress and comm.rank == 0 and time.perf_counter() - checked_at > 2.0:
             checked_at = time.perf_counter()
             print(f"[sweep {ex.id}] checking the grid: {i + 1}/{len(points)} points",
@@ -196,7 +216,26 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     states = open_sweep(out, mapping, point, comm)
     if point is None:  # a job of one point leaves the sweep's status to the record (others run)
         track(out, "sweep")
+    try:
+        return _run_points(problem, out, ex, points, states, mapping, n=n, k=k, T=T,
+                           restart=restart, max_points=max_points, plot=plot, figures=figures,
+                           progress=progress, ranks=ranks, point=point, comm=comm,
+                           wall_start=wall_start)
+    except BaseException as exc:
+        if point is not None and comm.rank == 0:  # interrupted or failed: an honest aggregate
+            settle(out, mapping, point, exc, plot, ex.id)
+        raise
 
+
+def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, max_points,
+                plot, figures, progress, ranks, point, comm, wall_start) -> dict:
+    """The points of this call (after the checks and the opening of the folder), and the
+    record."""
+    from damage_dolfinx.runtime.collective import classify, describe, mark
+    from damage_dolfinx.runtime.runfolder import RunLive
+    from damage_dolfinx.runtime.runner import run as run_one
+    from damage_dolfinx.studies.sweep_folder import record
+    size = comm.size
     if point is not None:
         pending = [] if states[point] == "completed" else [point]
         todo = pending
