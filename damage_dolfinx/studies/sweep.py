@@ -40,8 +40,10 @@ else "failed", "completed" or "incomplete".
 Failures: a point that fails on every rank of its group (a solver, a refused value, an
 exception of user code raised alike) is recorded as failed and the sweep goes on (the
 sweep's status "failed", exit status 3 on the command line); an exception on some ranks of a
-group only, or a signal, ends the whole sweep within seconds (runtime/collective.py), with
-one line and the statuses written.
+group only ends the whole sweep within seconds (runtime/collective.py), with one line and the
+statuses written. A stop signal that reaches some ranks only is passed on to every rank
+(sweep_stop.py): every point in progress stops at the end of its step with a checkpoint, and
+every rank ends normally with exit status 128 + signal.
 """
 from __future__ import annotations
 
@@ -56,6 +58,7 @@ from damage_dolfinx.parameters import InputError
 from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
                                                  SWEEP_FILES, plot_sweep)
 from damage_dolfinx.studies.sweep_folder import describe_values as _describe
+from damage_dolfinx.studies.sweep_stop import StopNotice
 
 
 def parse_values(text: str, name: str) -> list:
@@ -246,7 +249,7 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
     group = comm if ranks == size else MPI.COMM_SELF if ranks == 1 else \
         comm.Split(color, comm.rank)
     mine = todo[color::groups]
-    relay = _Relay(comm)
+    relay, notice = _Relay(comm), StopNotice(comm)
     if comm.rank == 0 and progress:
         if point is not None and not todo:
             print(f"[sweep {ex.id}] point {point} ({_describe(points[point])}) is already "
@@ -259,9 +262,10 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
                 f"{size} rank(s)"
             print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
                   f"running {len(todo)} on {layout}", flush=True)
-    failures = {}
+    failures, stopped = {}, None
     try:
         for i in mine:
+            notice.check()  # another rank stopped on a signal: this one too
             values = points[i]
             folder = out / f"point_{i}"
             resume = restart and states[i] == "checkpoint"
@@ -271,7 +275,8 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
                     group, comm, [(folder, "run")] + ([(out, "sweep")] if point is None else []),
                     lambda: run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
                                     progress=False, figures=figures, restart=resume,
-                                    overwrite=not resume, comm=group))
+                                    overwrite=not resume, comm=group,
+                                    on_step=notice.check))
                 status = summary["status"]
             except RunLive:
                 if point is not None:
@@ -279,7 +284,7 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
                 status = "live in another process, left to it"
             except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
                 if classify(exc)[2] == "interrupted":
-                    raise  # the sweep stops (collective.outcome decides for every rank)
+                    raise  # the sweep stops: every rank (below)
                 if group.rank == 0:
                     mark(folder, exc)
                 status = f"failed ({describe(exc)})"
@@ -289,9 +294,22 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
                     f"ranks {comm.rank}-{comm.rank + ranks - 1}"
                 relay.say(f"[sweep {ex.id}] point {i} ({_describe(values)}): {status} in "
                           f"{time.perf_counter() - start:.1f} s ({where})")
+    except BaseException as exc:  # noqa: BLE001 - a signal stops every rank; others raise
+        if classify(exc)[2] != "interrupted":
+            raise  # (one rank only: collective.outcome ends the others)
+        stopped = exc
+        notice.send(exc)
     finally:
         if group not in (comm, MPI.COMM_SELF):
             group.Free()
+    signum = notice.settle()  # every rank is here: stopped, or done with its points
+    if signum or stopped is not None:
+        relay.close()
+        if stopped is not None:
+            raise stopped
+        from damage_dolfinx.runtime.signals import RECEIVED, SignalStop
+        RECEIVED["signum"] = RECEIVED["signum"] or signum
+        raise SignalStop(signum)  # its points ended before the stop: stopped all the same
     failures = {i: why for part in comm.allgather(failures) for i, why in part.items()}
     relay.close()
     info = {"ran": todo, "mpi_size": size, "ranks_per_point": ranks, "groups": groups,
