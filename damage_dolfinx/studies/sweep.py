@@ -42,7 +42,7 @@ exception of user code raised alike) is recorded as failed and the sweep goes on
 sweep's status "failed", exit status 3 on the command line); an exception on some ranks of a
 group only ends the whole sweep within seconds (runtime/collective.py), with one line and the
 statuses written. A stop signal that reaches some ranks only is passed on to every rank
-(sweep_stop.py): every point in progress stops at the end of its step with a checkpoint, and
+(sweep_ranks.py): every point in progress stops at the end of its step with a checkpoint, and
 every rank ends normally with exit status 128 + signal.
 """
 from __future__ import annotations
@@ -58,7 +58,7 @@ from damage_dolfinx.parameters import InputError
 from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
                                                  SWEEP_FILES, plot_sweep)
 from damage_dolfinx.studies.sweep_folder import describe_values as _describe
-from damage_dolfinx.studies.sweep_stop import StopNotice
+from damage_dolfinx.studies.sweep_ranks import StopNotice, Relay, point_outcome
 
 
 def parse_values(text: str, name: str) -> list:
@@ -132,9 +132,10 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
     processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
-    from damage_dolfinx.validation import check_sweep
-    with outcome(comm):
-        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress)
+    from damage_dolfinx.validation import check_sweep, communicator
+    with outcome(communicator("comm", comm)):
+        checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress,
+                              out, comm)
         layout = _check_layout(ranks_per_point, point, checked["max_points"], comm)
         return _sweep(problem, out, grid, comm=comm, **checked, **layout)
 
@@ -188,6 +189,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     from damage_dolfinx.runtime import io
     from damage_dolfinx.runtime.collective import track
     from damage_dolfinx.runtime.runner import resolve
+    from damage_dolfinx.runtime.fingerprint import sweep_fingerprint
     from damage_dolfinx.studies.sweep_folder import open_sweep, settle
 
     wall_start = time.perf_counter()
@@ -215,6 +217,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                "points": [{"index": i, "folder": f"point_{i}", "values": values}
                           for i, values in enumerate(points)],
                "shared": _shared(ex, grid)}
+    mapping["fingerprint"] = sweep_fingerprint(ex, out, n, k, T, points[0], comm)
     out = io.prepare_output_dir(out, comm)
     states = open_sweep(out, mapping, point, comm)
     if point is None:  # a job of one point leaves the sweep's status to the record (others run)
@@ -249,7 +252,7 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
     group = comm if ranks == size else MPI.COMM_SELF if ranks == 1 else \
         comm.Split(color, comm.rank)
     mine = todo[color::groups]
-    relay, notice = _Relay(comm), StopNotice(comm)
+    relay, notice = Relay(comm), StopNotice(comm)
     if comm.rank == 0 and progress:
         if point is not None and not todo:
             print(f"[sweep {ex.id}] point {point} ({_describe(points[point])}) is already "
@@ -271,7 +274,7 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
             resume = restart and states[i] == "checkpoint"
             start = time.perf_counter()
             try:
-                summary = _point_outcome(
+                summary = point_outcome(
                     group, comm, [(folder, "run")] + ([(out, "sweep")] if point is None else []),
                     lambda: run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
                                     progress=False, figures=figures, restart=resume,
@@ -323,76 +326,3 @@ def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, 
               + (f", {len(failed)} failed" if failed else "") + " in "
               f"{summary['wall_time_s']:.1f} s; table {out / 'sweep.csv'}", flush=True)
     return summary
-
-
-def _point_outcome(group, comm, folders, body):
-    """``body()`` on every rank of ``group`` (the ranks running one point), with one outcome on
-    all of them: its value, or the same exception everywhere (a failing rank's own, the others
-    a collective.RankFailure of the same kind carrying its line). A rank that failed while its
-    partners do not join within collective.FAIL_WAIT seconds (they are blocked in a collective call it left)
-    ends the whole sweep: ``folders`` get the status, one line, MPI_Abort with its exit status
-    (collective.py's rule, here within one group while the sweep's other groups go on)."""
-    if group.size == 1:
-        return body()
-    from damage_dolfinx.runtime import collective
-    agree = group.Dup()  # before the body: a rank that fails inside it can still join
-    failure, value = None, None
-    try:
-        value = body()
-    except BaseException as exc:  # noqa: BLE001 - decided by the whole group below
-        failure = exc
-    mine = None if failure is None else \
-        (group.rank, *collective.classify(failure)[:2], collective.describe(failure))
-    request = agree.Ibarrier()
-    deadline = time.monotonic() + collective.FAIL_WAIT
-    while not request.Test():
-        if failure is not None and time.monotonic() > deadline:
-            collective._abort(comm, failure, folders)
-        time.sleep(0.002)
-    outcomes = agree.allgather(mine)
-    agree.Free()
-    failed = [o for o in outcomes if o is not None]
-    if not failed:
-        return value
-    if failure is not None:
-        raise failure
-    _, code, kind, text = failed[0]
-    raise collective.decided(text, code, kind)
-
-
-class _Relay:
-    """Progress lines of the groups' first ranks, printed by rank 0 alone (only rank 0
-    prints): rank 0 prints its own at once and the others' as they arrive, between its points
-    and at the end."""
-
-    TAG = 4242
-
-    def __init__(self, comm):
-        self.comm = comm.Dup() if comm.size > 1 else comm
-        self.sent, self.received, self.requests = 0, 0, []
-
-    def say(self, text):
-        if self.comm.rank == 0:
-            self._drain()
-            print(text, flush=True)
-        else:
-            self.requests.append(self.comm.isend(text, dest=0, tag=self.TAG))
-            self.sent += 1
-
-    def _drain(self):
-        status = MPI.Status()
-        while self.comm.size > 1 and self.comm.iprobe(source=MPI.ANY_SOURCE, tag=self.TAG,
-                                                      status=status):
-            print(self.comm.recv(source=status.Get_source(), tag=self.TAG), flush=True)
-            self.received += 1
-
-    def close(self):
-        """Collective: every line sent is printed before the summary line."""
-        if self.comm.size == 1:
-            return
-        counts = self.comm.gather(self.sent, root=0)
-        if self.comm.rank == 0:
-            for _ in range(sum(counts) - self.received):
-                print(self.comm.recv(source=MPI.ANY_SOURCE, tag=self.TAG), flush=True)
-        MPI.Request.Waitall(self.requests)
-        self.comm.Free()

@@ -80,7 +80,8 @@ def _open(out: Path, mapping: dict, point, apply: bool) -> list:
     wanted = json.loads(json.dumps(mapping))
     # "shared" (what the points share) came later: a folder written before it is compared
     # without it
-    keys = [key for key in wanted if key != "shared" or existing is None or key in existing]
+    keys = [key for key in wanted if key not in ("shared", "fingerprint") or existing is None
+            or key in existing]
     if existing is not None and {key: existing.get(key) for key in keys} != \
             {key: wanted[key] for key in keys}:
         raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
