@@ -38,15 +38,14 @@ class StopNotice:
     def check(self, step=None):
         """Between points, and after every step of a point (the run's ``on_step``; returns
         None: the run goes on): a notice that has come stops this rank as the signal itself
-        would (only the first one acts)."""
+        would."""
         if self.comm is None:
             return None
         status = MPI.Status()
-        first = not self.got
         while self.comm.iprobe(source=MPI.ANY_SOURCE, tag=self.TAG, status=status):
             source = status.Get_source()
             self.got[source] = self.comm.recv(source=source, tag=self.TAG)
-        if first and self.got and not self.sent:
+        if self.got and not self.sent:  # (again at every call: no next point either)
             from damage_dolfinx.runtime.signals import forward_stop
             forward_stop(min(self.got.values()))
         return None
