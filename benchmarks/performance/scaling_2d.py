@@ -104,7 +104,8 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
     return {"example": example, "n": n, "ranks": ranks, "mode": mode, "tag": tag,
             "options": list(options), "k": k, "steps": steps,
             "dofs_u": mesh["dofs_u"], "dofs_zeta": mesh["dofs_zeta"],
-            "command": " ".join(cmd[3:]) if ranks == 1 else " ".join(cmd),
+            "command": (f"mpirun -n {ranks} " if ranks > 1 else "") + " ".join(cmd[cmd.index(
+                "-f") + 2:]),
             "step_times_s": times, "step_s": float(np.mean(later)),
             "step_median_s": float(np.median(later)),
             "step_min_s": float(np.min(later)), "start_s": times[0], "first_step_s": times[1],
@@ -347,8 +348,9 @@ def report(out: Path, record: Path):
     (record / "crossover.md").write_text("\n".join(crossover_table(rows)) + "\n")
     (record / "difference.md").write_text("\n".join(difference(rows)) + "\n")
     (record / "variants.md").write_text("\n".join(variants_table(every)) + "\n")
-    (record / "runs.json").write_text(json.dumps(
-        [{k: v for k, v in r.items() if k != "folder"} for r in every], indent=1))
+    (record / "runs.json").write_text(json.dumps(  # paths relative to the checkout
+        [{k: v.replace(f"{REPO}/", "") if k == "command" else v for k, v in r.items()
+          if k != "folder"} for r in every], indent=1))
     plot(rows, record / "scaling.png")
     for name in ("scaling.md", "crossover.md", "difference.md", "variants.md"):
         print((record / name).read_text())
