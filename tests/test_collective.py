@@ -42,7 +42,12 @@ SCRIPT = textwrap.dedent('''
                          boundaries={"clamped": 1, "traction": 2, "tresca": 3},
                          traction=traction, damage_law=dd.DamageLaw(law, "own"),
                          params={"E": 2000.0, "g_fric": 10.0})
-    dd.run(problem, sys.argv[1], figures=False, progress=False)
+    try:
+        dd.run(problem, sys.argv[1], figures=False, progress=False)
+    except dd.InputError as exc:  # a refusal decided on every rank alike (the script's line)
+        if MPI.COMM_WORLD.rank == 0:
+            print(f"damage-dolfinx: error: {exc}", file=sys.stderr)
+        sys.exit(2)
 ''')
 
 
