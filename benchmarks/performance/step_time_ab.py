@@ -17,8 +17,9 @@ process waited for a core. For each example:
    its default time step k and step time choose T so that a timed run steps for about
    ``--run-seconds``);
 2. pairs of timed runs, the order alternating (AB, BA, AB, ...) so that a slow drift of the
-   machine cancels, until ``--pairs`` pairs are done or ``--budget`` seconds have passed
-   (at least 3 pairs);
+   machine cancels (with ``--together 0,1``: the two of a pair at the same time, each pinned to
+   its own processor, the processors swapped every pair), until ``--pairs`` pairs are done
+   or ``--budget`` seconds have passed (at least 3 pairs);
 3. the ratio NEW/OLD of each pair, their median, and a bootstrap 95 % interval of that
    median (pairs resampled with replacement, 10 000 times).
 
@@ -48,19 +49,30 @@ LAUNCH = {"wall": "from damage_dolfinx.cli import main; import sys; sys.exit(mai
                  "from damage_dolfinx.cli import main; import sys; sys.exit(main())"}
 
 
-def run(python, example, n, T, out, clock="cpu"):
-    """One whole run; returns (median step time over steps >= 2, steps done, k)."""
+def command(python, example, n, T, out, clock):
     cmd = [python, "-c", LAUNCH[clock], "run", example, "--n", str(n), "--no-figures",
            "--quiet", "--history-every", "1", "--checkpoint-seconds", "0", "--overwrite",
            "--out", str(out)]
-    if T is not None:
-        cmd += ["--T", repr(T)]
+    return cmd + (["--T", repr(T)] if T is not None else [])
+
+
+def launch(python, example, n, T, out, clock="cpu", cpu=None):
+    """A whole run started; ``cpu``: the one processor it may use (None: any)."""
+    cmd = command(python, example, n, T, out, clock)
     # run from the output folder: a checkout's own tree on the path would shadow the
     # interpreter's installed package
     out.mkdir(parents=True, exist_ok=True)
-    done = subprocess.run(cmd, capture_output=True, text=True, cwd=out)
-    if done.returncode != 0:
-        sys.exit(f"{' '.join(cmd)} failed ({done.returncode}): {done.stderr.strip()[-400:]}")
+    pin = (lambda: os.sched_setaffinity(0, {cpu})) if cpu is not None else None
+    return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            cwd=out, preexec_fn=pin), cmd, out
+
+
+def finish(started):
+    """(median step time over steps >= 2, steps done, k) of a started run."""
+    proc, cmd, out = started
+    _, err = proc.communicate()
+    if proc.returncode != 0:
+        sys.exit(f"{' '.join(cmd)} failed ({proc.returncode}): {err.strip()[-400:]}")
     with open(out / "history.csv", newline="") as f:
         times = [float(r["step_time_s"]) for r in csv.DictReader(f) if int(r["step"]) >= 2]
     summary = json.loads((out / "summary.json").read_text())
@@ -68,7 +80,12 @@ def run(python, example, n, T, out, clock="cpu"):
             float(summary["k"]))
 
 
+def run(python, example, n, T, out, clock="cpu"):
+    return finish(launch(python, example, n, T, out, clock))
+
+
 def bootstrap_median(ratios, resamples=10000, seed=0):
+    """2.5 and 97.5 percentiles of the median of ``ratios`` resampled with replacement."""
     rng = np.random.default_rng(seed)
     r = np.asarray(ratios)
     medians = np.median(r[rng.integers(0, len(r), (resamples, len(r)))], axis=1)
@@ -93,15 +110,24 @@ def measure(old, new, example, n, args, work):
     while len(ratios) < args.pairs and (len(ratios) < 3
                                         or time.perf_counter() - start < args.budget):
         order = ("old", "new") if len(ratios) % 2 == 0 else ("new", "old")
+        python = {"old": old, "new": new}
         got = {}
-        for which in order:
-            got[which], n_steps, _ = run(old if which == "old" else new, example, n, T,
-                                         work / which, args.clock)
+        if args.together:  # both at once, each on its own processor, swapped every pair
+            runs = {which: launch(python[which], example, n, T, work / which, args.clock, cpu)
+                    for which, cpu in zip(order, args.together)}
+            for which in order:
+                got[which], n_steps, _ = finish(runs[which])
+        else:
+            for which in order:
+                got[which], n_steps, _ = run(python[which], example, n, T, work / which,
+                                             args.clock)
         per["old"].append(got["old"])
         per["new"].append(got["new"])
         ratios.append(got["new"] / got["old"])
     lo, hi = bootstrap_median(ratios)
-    return {"example": example, "n": n, "clock": args.clock, "k": k, "steps_per_run": n_steps, "pairs": len(ratios),
+    return {"example": example, "n": n, "clock": args.clock, "together": bool(args.together),
+            "k": k, "steps_per_run": n_steps,
+            "pairs": len(ratios),
             "old_median_step_s": float(np.median(per["old"])),
             "new_median_step_s": float(np.median(per["new"])),
             "ratio_new_old_median": float(np.median(ratios)), "ratio_ci95": [lo, hi],
@@ -122,6 +148,9 @@ def main():
     p.add_argument("--max-steps", type=int, default=2000)
     p.add_argument("--clock", choices=("cpu", "wall"), default="cpu",
                    help="step time as the process's CPU time (default) or wall time")
+    p.add_argument("--together", metavar="CPU,CPU", type=lambda s: [int(c) for c in s.split(",")],
+                   help="run the two of a pair at the same time, pinned to these two "
+                        "processors (swapped every pair): both see the same state of the machine")
     p.add_argument("--json", help="write the results to this JSON file")
     args = p.parse_args()
     # absolute, not resolved: a venv's interpreter is a symlink that must stay in its venv
