@@ -12,7 +12,8 @@ well). Above it:
   2 translations, 1 rotation; 6 in 3-D), CG started from the previous step's solution. A
   constant matrix (3.1) is set up once; a matrix that changes every step (2.1, with zeta_n)
   keeps the AMG hierarchy of an earlier step while CG needs at most ``MECH_AMG_REBUILD_ITS``
-  iterations (the lagged scheme of ``LinearSolver``);
+  iterations (the lagged scheme of ``LinearSolver``; ``-<prefix>amg_rebuild_its N`` moves the
+  bound; measured against rebuilding every step in docs/solvers.md);
 * the damage PDE step (M + k kappa K, SPD, constant for a fixed k): CG + AMG, set up once
   (hypre BoomerAMG where PETSc has it, else GAMG).
 
