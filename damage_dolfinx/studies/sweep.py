@@ -48,6 +48,7 @@ every rank ends normally with exit status 128 + signal.
 from __future__ import annotations
 
 import itertools
+import json
 import math
 import time
 from pathlib import Path
@@ -173,6 +174,23 @@ def _check_point(ex, i, values, n, k, T, meshes, together, comm):
         raise InputError(f"point {i} ({_describe(values)}): {exc}") from None
 
 
+def _another_sweep(out, mapping, comm):
+    """InputError when ``out``/points.json holds a sweep of another problem, grid, n, k or T
+    (the refusal that names the folder's sweep, before a changed fingerprint is named)."""
+    keys = ("schema", "case", "grid", "n", "k", "T")
+    other = False
+    if comm.rank == 0:
+        try:
+            saved = json.loads((Path(out) / "points.json").read_text())
+            wanted = json.loads(json.dumps({key: mapping[key] for key in keys}))
+            other = isinstance(saved, dict) and {key: saved.get(key) for key in keys} != wanted
+        except (OSError, ValueError):
+            other = False
+    if comm.bcast(other, root=0):
+        raise InputError(f"{str(out)!r} holds another sweep (a different problem, grid, n, k or "
+                         "T in its points.json); choose another out folder")
+
+
 def _shared(ex, grid) -> dict:
     """What every point shares besides n, k, T (points.json "shared"): the model, the reading
     and the parameters not swept (those a file can hold: numbers, text, flags)."""
@@ -217,7 +235,11 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                "points": [{"index": i, "folder": f"point_{i}", "values": values}
                           for i, values in enumerate(points)],
                "shared": _shared(ex, grid)}
-    mapping["fingerprint"] = sweep_fingerprint(ex, out, n, k, T, points[0], comm)
+    try:
+        mapping["fingerprint"] = sweep_fingerprint(ex, out, n, k, T, points[0], comm)
+    except InputError:
+        _another_sweep(out, mapping, comm)  # another grid, problem, n, k or T: said first
+        raise
     out = io.prepare_output_dir(out, comm)
     states = open_sweep(out, mapping, point, comm)
     if point is None:  # a job of one point leaves the sweep's status to the record (others run)

@@ -79,8 +79,8 @@ def point_outcome(group, comm, folders, body):
     """``body()`` on every rank of ``group`` (the ranks running one point), with one outcome on
     all of them: its value, or the same exception everywhere (a failing rank's own, the others
     a collective.RankFailure of the same kind carrying its line). A rank that failed while its
-    partners do not join within collective.FAIL_WAIT seconds (they are blocked in a collective call it left)
-    ends the whole sweep: ``folders`` get the status, one line, MPI_Abort with its exit status
+    partners do not join within collective.FAIL_WAIT seconds (they are blocked in a collective
+    call it left) ends the whole sweep: ``folders`` get the status, one line, MPI_Abort with its exit status
     (collective.py's rule, here within one group while the sweep's other groups go on)."""
     if group.size == 1:
         return body()
