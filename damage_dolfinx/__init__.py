@@ -10,8 +10,8 @@ The public face (everything else is internal and may change):
   monitors, a stop on your criterion);
 * :class:`Model` (the base of every model: a model of your own derives from it, from the
   building blocks of :mod:`damage_dolfinx.blocks`), :class:`SubStep`
-  (a model is built from a :class:`Problem` whose mesh is built), :func:`register_model`, :func:`model_class` (a model's class
-  by id);
+  (a model is built from a :class:`Problem` whose mesh is built), :func:`register_model`,
+  :func:`model_class` (a model's class by id);
 * :class:`DamageLaw` and the thesis laws :data:`THESIS_A`, :data:`THESIS_B`;
 * :func:`read_run`: a run folder back into a script (summary, history arrays, fields at any
   stored time);

@@ -17,12 +17,33 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
 from damage_dolfinx.parameters import InputError, TimeGrid
 from damage_dolfinx.problem import MAX_STEPS, READINGS, Problem  # noqa: F401
+
+
+#: the catalogue's short labels of its assumptions (a "G" and a number, with a slash-joined
+#: list-item number before it, a colon after it, or in brackets), and what each says in words:
+#: a value the thesis does not give, assumed
+_LABELS = [
+    (re.compile(r"^(?:[\d.]+/)?G\d+[a-z]?(?:/G?\d+[a-z]?)*(?:/[\d.]+)?:\s*"), "assumed: "),
+    (re.compile(r"\((?:G\d+[a-z]?)(?:[,/ ]+G\d+[a-z]?)*\)"), "(assumed)"),
+    (re.compile(r"\b(?:[\d.]+/)?G\d+[a-z]?(?:/G\d+[a-z]?)*\b"), "assumed"),
+]
+
+
+def in_words(assumption: str) -> str:
+    """An assumption of the catalogue as a run records it (summary.json): its short labels
+    replaced by what they mean (a labelled ``kappa = 1 ...`` -> ``assumed: kappa = 1 ...``).
+    The reading entries (``R<n> (evidence reading; <basis>): ...``) keep their form: it says
+    what they are, and the departure records are read from it."""
+    for pattern, words in _LABELS:
+        assumption = pattern.sub(words, assumption)
+    return assumption
 
 
 @dataclass
@@ -88,8 +109,9 @@ class Example(Problem):
         return dataclasses.replace(
             base, params=base.params.replace(**r.overrides),
             traction=r.traction or base.traction, body_force=r.body_force or base.body_force,
-            assumptions=[f"reading: {name} ({label}; {departures})"] + base.assumptions
-            + r.assumptions, reading=name, literal=base)
+            assumptions=[f"reading: {name} ({label}; {departures})"]
+            + [in_words(a) for a in base.assumptions + r.assumptions], reading=name,
+            literal=base)
 
     def checked(self) -> "Example":
         """The example under its reading (the default one when none is applied yet)."""

@@ -64,7 +64,7 @@ def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     tags), read on rank 0 and distributed over ``comm``. ``dim``: the dimension the problem
     needs (None: the file's). Raises InputError with the file name and what is wrong."""
     from damage_dolfinx.validation import check_mesh_reading
-    check_mesh_reading(path, dim)
+    check_mesh_reading(path, dim, comm)
     path = Path(path)
     if path.suffix.lower() != ".msh":
         raise InputError(f"mesh file {str(path)!r}: expected a gmsh .msh file")
@@ -91,9 +91,13 @@ def from_gmsh(model=None, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
     import_gmsh_keeping_sigint()
     import gmsh
-    from damage_dolfinx.validation import check_dim
+    from damage_dolfinx.validation import check_dim, communicator
     check_dim(dim)
+    communicator("comm", comm)
     model = model or gmsh.model
+    if not hasattr(model, "getDimension"):
+        raise InputError(f"from_gmsh: model must be a gmsh model (gmsh.model), got "
+                         f"{type(model).__name__}")
     error = _check_model(dim)(gmsh) if comm.rank == 0 else None
     error = comm.bcast(error, root=0)
     if error:

@@ -1,5 +1,7 @@
-"""The one validation layer of the public API (and of the command line, which maps onto it):
-every argument of :class:`~damage_dolfinx.Problem`, :func:`~damage_dolfinx.run`,
+"""The one validation layer of the public API (and of the command line, which maps onto it),
+first half: the scalars and the arguments of the entry points, each checked by its name
+(``ARGUMENTS``); a Problem's own data are checked in :mod:`damage_dolfinx.validation_problem`.
+Every argument of :class:`~damage_dolfinx.Problem`, :func:`~damage_dolfinx.run`,
 :func:`~damage_dolfinx.converge`, :func:`~damage_dolfinx.sweep`,
 :func:`~damage_dolfinx.read_mesh` and :func:`~damage_dolfinx.from_gmsh` is checked here for its
 type, its range and, once the mesh exists, its shape against the mesh dimension (loads and
@@ -11,7 +13,6 @@ NumPy scalars are accepted wherever a number is (``T=np.int64(1)``); booleans ar
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 import numbers
 from pathlib import Path
@@ -111,85 +112,7 @@ def path(name, value, allow_none=False):
     return value
 
 
-# ---------------------------------------------------------------------------- Problem
-def check_problem(problem):
-    """The problem with its scalars normalised (NumPy scalars to Python), or InputError.
-    Called where the Problem is turned into a run (``Problem.checked``)."""
-    from damage_dolfinx.laws import DamageLaw
-    from damage_dolfinx.models.registry import MODELS, model as model_class
-    from damage_dolfinx.parameters import ModelParameters
-    model = problem.model
-    if isinstance(model, np.str_):
-        model = str(model)
-    if not isinstance(model, (str, type)):
-        raise InputError(f"model must be a model id ({', '.join(MODELS)}) or a model class, "
-                         f"got {_shown(model)}")
-    info = model_class(model)  # InputError for an unknown id
-    T = positive("T (final time)", problem.T)
-    k = positive("k (time step)", problem.k, allow_none=True)
-    if k is not None and k > T * (1 + 1e-12):
-        raise InputError(f"k (time step) must not exceed T = {T:g}, got k = {k:g}")
-    n = whole("n (mesh level)", problem.n, allow_none=True)
-    mesh = problem.mesh
-    _check_mesh_argument(mesh)
-    roles = _check_boundaries(problem.boundaries, info)
-    params = problem.params
-    if params is not None and not isinstance(params, (dict, ModelParameters)):
-        raise InputError(f"params must be a dict of changes or a ModelParameters "
-                         f"(model_defaults({info.id!r})), got {type(params).__name__}")
-    if isinstance(params, ModelParameters):
-        _check_parameters_of(params, info, problem.damage_law is not None)
-    elif isinstance(params, dict):
-        params = {_key("params", key): _param_value(key, value) for key, value in params.items()}
-    for name in ("traction", "body_force"):
-        value = getattr(problem, name)
-        if value is not None and not callable(value):
-            raise InputError(f"{name} must be a function (x, t) -> UFL vector, got "
-                             f"{_shown(value)} ({type(value).__name__})")
-    if problem.traction is not None and roles is not None and "traction" not in roles:
-        raise InputError("traction is given but no boundary part has the 'traction' role: "
-                         "add boundaries={'traction': tag, ...} (else the load acts nowhere)")
-    zeta0 = problem.zeta0
-    if not callable(zeta0):
-        zeta0 = real("zeta0 (initial damage)", zeta0, low=0.0, high=1.0, low_open=True,
-                     what="a number in (0, 1] or a function of x")
-    if problem.damage_law is not None and not isinstance(problem.damage_law, DamageLaw):
-        raise InputError(f"damage_law must be a damage_dolfinx.DamageLaw (DamageLaw(function, "
-                         f"name)), got {_shown(problem.damage_law)}")
-    irreversible = flag("irreversible", problem.irreversible)
-    allow = flag("allow_unstable", problem.allow_unstable)
-    name = text("name", problem.name)
-    if "/" in name or name in (".", ".."):
-        raise InputError(f"name must not contain '/', got {name!r}")
-    if not isinstance(problem.builders, dict):
-        raise InputError(f"builders must be a dict, got {type(problem.builders).__name__}")
-    checked = dataclasses.replace(problem, model=model, T=T, k=k, n=n, params=params,
-                                  zeta0=zeta0, irreversible=irreversible,
-                                  allow_unstable=allow, name=name)
-    zeta_star = checked.parameters().zeta_star
-    if not callable(zeta0) and zeta0 < zeta_star:
-        raise InputError(f"zeta0 (initial damage) must lie in [zeta_star, 1] = [{zeta_star:g}, "
-                         f"1], got {zeta0:g}")
-    return checked
-
-
-def _check_mesh_argument(mesh):
-    from damage_dolfinx.geometries import Geometry
-    if isinstance(mesh, Geometry) or callable(mesh):
-        return
-    if isinstance(mesh, tuple):
-        if len(mesh) != 2:
-            raise InputError(f"mesh as a tuple must be (mesh, facet_tags), got {len(mesh)} items")
-        return
-    if isinstance(mesh, (str, Path)):
-        problem = mesh_path_problem(Path(mesh))
-        if problem:
-            raise InputError(f"mesh file {str(mesh)!r}: {problem}")
-        return
-    raise InputError("mesh must be a Geometry, a (mesh, facet_tags) pair, a .msh path or a "
-                     f"function (comm, n) -> one of these; got {type(mesh).__name__}")
-
-
+# ---------------------------------------------------------------------------- mesh files
 def mesh_path_problem(p: Path):
     """What is wrong with a mesh file path before it is opened (None: nothing)."""
     if p.is_dir():
@@ -203,178 +126,81 @@ def mesh_path_problem(p: Path):
     return None
 
 
-def _check_boundaries(boundaries, info):
-    """The roles named, or None (the mesh's own tags)."""
-    if boundaries is None:
-        return None
-    if not isinstance(boundaries, dict) or not boundaries:
-        raise InputError("boundaries must be a dict {role: tag or [tags]}, got "
-                         f"{_shown(boundaries)}")
-    allowed = tuple(info.boundary_roles())  # the model's declaration (Model.boundary_roles)
-    for role, tags in boundaries.items():
-        if role not in allowed:
-            raise InputError(f"boundaries: role {role!r} is not one of model {info.id}'s: "
-                             f"{', '.join(allowed)}")
-        listed = [tags] if is_real(tags) or isinstance(tags, str) else tags
-        if isinstance(listed, (bytes, dict)) or not hasattr(listed, "__iter__"):
-            raise InputError(f"boundaries[{role!r}] must be a facet tag, a gmsh physical name "
-                             f"or a list of these, got {_shown(tags)}")
-        listed = list(listed)
-        if not listed:
-            raise InputError(f"boundaries[{role!r}] lists no facet tag")
-        for tag in listed:
-            if isinstance(tag, str):  # a gmsh physical name: looked up on the mesh (meshes.py)
-                if not tag.strip():
-                    raise InputError(f"boundaries[{role!r}]: an empty physical name")
-                continue
-            whole(f"boundaries[{role!r}] (a facet tag or a gmsh physical name)", tag, low=0)
-    return set(boundaries)
+def check_problem(problem):
+    """The Problem's own checks (validation_problem.check_problem)."""
+    from damage_dolfinx.validation_problem import check_problem as check
+    return check(problem)
 
 
-def _key(name, key):
-    if not isinstance(key, str) or not key:
-        raise InputError(f"{name}: names must be text, got {_shown(key)}")
-    return key
-
-
-def _param_value(key, value):
-    """A parameter value: a number (NumPy scalars to Python), a flag or a word."""
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if is_real(value):
-        v = float(value) if isinstance(value, (float, np.floating)) else int(value)
-        if isinstance(v, float) and math.isnan(v):
-            raise InputError(f"params[{key!r}] must be a number, got nan")
-        return v
-    if isinstance(value, str) or value is None or callable(value):
-        return value
-    raise InputError(f"params[{key!r}] must be a number, a flag or a word, got "
-                     f"{_shown(value)} ({type(value).__name__})")
-
-
-def _check_parameters_of(params, info, own_law):
-    """A ModelParameters built for another model (model_defaults('3.3') given to a 2.2
-    problem) lacks this model's data, or carries data the model does not read (allowed only as
-    the data of one's own damage law)."""
-    own = info.defaults()
-    missing = sorted(set(own.extra) - set(params.extra))
-    if missing:
-        raise InputError(f"params: a ModelParameters without model {info.id}'s data "
-                         f"({', '.join(missing)}); start from model_defaults({info.id!r})")
-    foreign = sorted(set(params.extra) - set(own.extra))
-    if foreign and not own_law:
-        raise InputError(f"params: a ModelParameters with data model {info.id} does not read "
-                         f"({', '.join(foreign[:6])}{', ...' if len(foreign) > 6 else ''}): "
-                         f"another model's? start from model_defaults({info.id!r})")
-
-
-# ---------------------------------------------------------------------------- with the mesh
 def check_data(data):
-    """The loads, the damage law, the initial damage and the boundary parts against the mesh
-    (called once the geometry exists, before any solver is set up): shapes from the UFL
-    expressions the user's functions build, evaluated symbolically."""
-    import ufl
-    from damage_dolfinx.laws import THESIS_A, THESIS_B
-    msh = data.geometry.mesh
-    gdim = msh.geometry.dim
-    x = ufl.SpatialCoordinate(msh)
-    t = _time_constant(msh)
-    for name in ("traction", "body_force"):
-        fn = getattr(data, name)
-        if fn is None:
-            continue
-        value = _call(name, "(x, t)", fn, x, t)
-        _expect_shape(name, value, (gdim,), f"a UFL vector of {gdim} components "
-                      f"(ufl.as_vector(({', '.join(['...'] * gdim)})))")
-    if data.traction is not None:
-        from damage_dolfinx.meshes import tag_counts
-        from damage_dolfinx.models.registry import TRACTION
-        if not tag_counts(data.geometry).get(TRACTION):
-            raise InputError("traction is given but the mesh has no boundary part with the "
-                             f"traction role (tag {TRACTION}): name it in boundaries")
-    law = data.damage_law
-    if law is not None and law not in (THESIS_A, THESIS_B):
-        e = ufl.sym(ufl.outer(x, x))
-        z = x[0] * 0 + t + 1.0
-        value = _call(f"damage_law {law.name!r}", "(eps, zeta, params)", law, e, z, data.params)
-        _expect_shape(f"damage_law {law.name!r}", value, (), "a UFL scalar")
-    z0 = data.zeta0
-    if callable(z0):  # at the mesh nodes, where the P1 interpolation takes it
-        from mpi4py import MPI
-        pts = np.ascontiguousarray(msh.geometry.x.T)
-        pts = pts[:gdim] if gdim < 3 else pts
-        try:
-            values = np.asarray(z0(pts), dtype=float)
-        except Exception as exc:  # noqa: BLE001 - a user function: named, one line
-            raise InputError(f"zeta0(x) raised {type(exc).__name__}: {exc} (x: a NumPy array of "
-                             f"shape ({gdim}, N))") from None
-        if values.shape not in ((pts.shape[1],), (1, pts.shape[1])):
-            raise InputError(f"zeta0(x) must return one value per point (shape (N,)), got "
-                             f"shape {values.shape} for N = {pts.shape[1]}")
-        comm = msh.comm
-        lo = comm.allreduce(float(np.min(values)) if values.size else np.inf, op=MPI.MIN)
-        hi = comm.allreduce(float(np.max(values)) if values.size else -np.inf, op=MPI.MAX)
-        zs = data.params.zeta_star
-        if not (np.isfinite(lo) and np.isfinite(hi)) or lo < zs - 1e-12 or hi > 1.0 + 1e-12:
-            raise InputError(f"zeta0(x) must lie in [zeta_star, 1] = [{zs:g}, 1] at every mesh "
-                             f"node, got values in [{lo:.4g}, {hi:.4g}]")
-
-
-def _time_constant(msh):
-    from damage_dolfinx import compat  # noqa: F401 - fem.Constant is the same everywhere
-    from dolfinx import fem
-    return fem.Constant(msh, 0.0)
-
-
-def _call(name, signature, fn, *args):
-    try:
-        return fn(*args)
-    except InputError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - a user function: named, one line
-        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-        raise InputError(f"{name}{signature} cannot be built from UFL arguments: "
-                         f"{type(exc).__name__}: {first}") from None
-
-
-def _expect_shape(name, value, shape, expected):
-    import ufl
-    from ufl.core.expr import Expr
-    if isinstance(value, (tuple, list)):
-        raise InputError(f"{name} must return {expected}, got a {type(value).__name__} "
-                         "(wrap it in ufl.as_vector)")
-    if is_real(value) and shape == ():
-        return
-    if not isinstance(value, Expr):
-        raise InputError(f"{name} must return {expected}, got {_shown(value)} "
-                         f"({type(value).__name__})")
-    if value.ufl_shape != shape or value.ufl_free_indices:
-        got = "a scalar" if value.ufl_shape == () else f"shape {value.ufl_shape}"
-        raise InputError(f"{name} must return {expected}, got {got}")
-    del ufl
+    """The Problem's data against its mesh (validation_problem.check_data)."""
+    from damage_dolfinx.validation_problem import check_data as check
+    return check(data)
 
 
 # ---------------------------------------------------------------------------- entry points
+def communicator(name, value):
+    from mpi4py import MPI
+    if not isinstance(value, MPI.Comm):
+        raise InputError(f"{name} must be an MPI communicator (e.g. MPI.COMM_WORLD), got "
+                         f"{_shown(value)} ({type(value).__name__})")
+    return value
+
+
+def callback(name, value, signature="(step)"):
+    if value is not None and not callable(value):
+        raise InputError(f"{name} must be a function {signature} or None, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    return value
+
+
+def _maybe(check):
+    return lambda name, value: check(name, value, allow_none=True)
+
+
+#: every keyword argument of the entry points (run, steps, converge, sweep, read_mesh,
+#: from_gmsh), checked by its name: one rule per name, whichever function takes it
+ARGUMENTS = {
+    "out": path, "n": _maybe(whole), "k": _maybe(positive), "T": _maybe(positive),
+    "restart": flag, "overwrite": flag, "progress": flag, "figures": flag,
+    "checkpoint_every": _maybe(whole), "max_points": _maybe(whole),
+    "plot": _maybe(text), "comm": communicator, "on_step": callback,
+    "ref_n": whole, "ref_k": positive,
+    "ranks_per_point": _maybe(whole),
+    "point": lambda name, value: whole(name, value, low=0, allow_none=True),
+}
+
+
+def arguments(**given) -> dict:
+    """``given`` with each value checked (and normalised: NumPy scalars to Python) by the rule
+    of its name in ARGUMENTS; InputError naming the first argument that fails."""
+    return {name: ARGUMENTS[name](name, value) for name, value in given.items()}
+
+
 def check_run(n=None, k=None, T=None, restart=False, overwrite=False, checkpoint_every=None,
-              progress=True, figures=True, out=None):
-    """The arguments of run() besides the problem."""
-    path("out", out)
-    return dict(n=whole("n", n, allow_none=True), k=positive("k", k, allow_none=True),
-                T=positive("T", T, allow_none=True), restart=flag("restart", restart),
-                overwrite=flag("overwrite", overwrite),
-                checkpoint_every=whole("checkpoint_every", checkpoint_every, allow_none=True),
-                progress=flag("progress", progress), figures=flag("figures", figures))
+              progress=True, figures=True, out=None, comm=None, on_step=None):
+    """The arguments of run() and steps() besides the problem."""
+    extra = {} if comm is None else {"comm": comm}
+    return arguments(out=out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                     checkpoint_every=checkpoint_every, progress=progress, figures=figures,
+                     on_step=on_step, **extra)
 
 
-def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True):
+def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True, progress=True,
+                   out=None, comm=None):
     """The levels of converge(): lists of whole n and positive k, the reference's, T, and its
-    two flags."""
-    return (levels("n", n, whole), levels("k", k, positive), whole("ref_n", ref_n),
-            positive("ref_k", ref_k), positive("T", T, allow_none=True),
-            flag("restart", restart), flag("overwrite", overwrite))
+    flags (its folder and communicator when given)."""
+    extra = {} if comm is None else {"comm": comm}
+    if out is not None:
+        extra["out"] = out
+    rest = arguments(ref_n=ref_n, ref_k=ref_k, T=T, restart=restart, overwrite=overwrite,
+                     progress=progress, **extra)
+    return (levels("n", n, whole), levels("k", k, positive), rest["ref_n"], rest["ref_k"],
+            rest["T"], rest["restart"], rest["overwrite"])
 
 
-def check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress):
+def check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress, out=None,
+                comm=None):
     """The arguments of sweep() besides the problem and the grid's values (check_grid)."""
     if isinstance(grid, dict) and grid:
         sizes = [len(v) if hasattr(v, "__len__") and not isinstance(v, (str, bytes)) else 1
@@ -383,18 +209,20 @@ def check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress):
         if total > MAX_SWEEP_POINTS:
             raise InputError(f"the grid has {total:.3g} points ({' x '.join(map(str, sizes))}), "
                              f"more than {MAX_SWEEP_POINTS}: split it into several sweeps")
-    return dict(n=whole("n", n, allow_none=True), k=positive("k", k, allow_none=True),
-                T=positive("T", T, allow_none=True), restart=flag("restart", restart),
-                max_points=whole("max_points", max_points, allow_none=True),
-                plot=text("plot", plot, allow_none=True), figures=flag("figures", figures),
-                progress=flag("progress", progress))
+    extra = {} if comm is None else {"comm": comm}
+    arguments(out=out, **extra)
+    return arguments(n=n, k=k, T=T, restart=restart, max_points=max_points, plot=plot,
+                     figures=figures, progress=progress)
 
 
-def check_mesh_reading(path_value, dim):
-    """read_mesh's arguments: a path to a regular file, a dimension 2 or 3 (or None)."""
+def check_mesh_reading(path_value, dim, comm=None):
+    """read_mesh's arguments: a path to a regular file, a dimension 2 or 3 (or None), a
+    communicator."""
     if not isinstance(path_value, (str, Path)) or not str(path_value):
         raise InputError(f"read_mesh: path must be a file path, got {_shown(path_value)}")
     check_dim(dim)
+    if comm is not None:
+        communicator("comm", comm)
     problem = mesh_path_problem(Path(path_value))
     if problem:
         raise InputError(f"mesh file {str(path_value)!r} {problem}")

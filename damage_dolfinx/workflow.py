@@ -47,9 +47,10 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     """
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.runner import run as _run
-    from damage_dolfinx.validation import check_run
-    with outcome(comm):
-        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out)
+    from damage_dolfinx.validation import check_run, communicator
+    with outcome(communicator("comm", comm)):
+        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out,
+                            comm, on_step)
         n, k, T, restart, overwrite = (checked[key] for key in ("n", "k", "T", "restart",
                                                                  "overwrite"))
         checkpoint_every, progress, figures = (checked[key] for key in (
@@ -76,6 +77,11 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
     rank iterates and must stop at the same step (decide from collective values, as
     ``contact_resultant()`` is). Bad input raises InputError here, before any work."""
     from damage_dolfinx.runtime.loop import Run
+    from damage_dolfinx.validation import check_run
+    checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out,
+                        comm)
+    n, k, T, restart, overwrite, checkpoint_every, progress, figures = (checked[key] for key in (
+        "n", "k", "T", "restart", "overwrite", "checkpoint_every", "progress", "figures"))
     return Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
                        overwrite=overwrite, checkpoint_every=checkpoint_every,
                        progress=progress, figures=figures, comm=comm).steps()
@@ -100,10 +106,10 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart
     ``overwrite=False`` refuses a folder that holds a study."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    from damage_dolfinx.validation import check_converge
-    with outcome(comm):
-        n, k, ref_n, ref_k, T, restart, overwrite = check_converge(n, k, ref_n, ref_k, T,
-                                                                   restart, overwrite)
+    from damage_dolfinx.validation import check_converge, communicator
+    with outcome(communicator("comm", comm)):
+        n, k, ref_n, ref_k, T, restart, overwrite = check_converge(
+            n, k, ref_n, ref_k, T, restart, overwrite, progress, out, comm)
         return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
                      progress=progress, comm=comm, restart=restart, overwrite=overwrite)
 

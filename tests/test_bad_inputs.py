@@ -81,3 +81,54 @@ def test_one_level_study_writes_null_rates_with_a_reason(tmp_path):
     summary = json.loads((tmp_path / "o" / "summary.json").read_text())
     assert summary["rates"]["h_plus_k_all"] is None
     assert summary["null_values"]["rates.h_plus_k_all"] == "NaN" and "rates_note" in summary
+
+
+def test_every_argument_of_every_entry_point_has_a_rule():
+    """Each keyword argument of run, steps, converge, sweep, read_mesh and from_gmsh is checked
+    by the rule of its name (validation.ARGUMENTS) or by a check of its own (the problem, the
+    grid, the levels, the mesh path and dimension, the gmsh model); a wrong type of each is
+    refused with InputError naming it."""
+    import inspect
+    import numpy as np
+    import damage_dolfinx as dd
+    from damage_dolfinx import validation
+    own = {"problem", "grid", "path", "dim", "model"}
+    levels = {"n", "k"}  # converge: lists, by validation.levels
+    for fn in (dd.run, dd.steps, dd.converge, dd.sweep, dd.read_mesh, dd.from_gmsh):
+        names = set(inspect.signature(fn).parameters) - own
+        if fn is dd.converge:
+            names -= levels
+        if fn is dd.sweep:  # **kwargs: the options of the sweep itself
+            from damage_dolfinx.studies.sweep import sweep
+            names = set(inspect.signature(sweep).parameters) - own
+        assert names <= set(validation.ARGUMENTS), (fn.__name__, names - set(
+            validation.ARGUMENTS))
+    wrong = {"comm": "world", "on_step": 5, "out": None, "progress": "no", "point": -1,
+             "ref_k": float("nan"), "n": np.float64(2.0)}
+    for name, value in wrong.items():
+        with pytest.raises(dd.InputError, match=name):
+            validation.arguments(**{name: value})
+    assert validation.arguments(n=np.int64(3), T=np.float32(0.5)) == {"n": 3, "T": 0.5}
+
+
+def test_an_option_the_user_set_between_two_runs_is_kept_and_fingerprinted():
+    """A solver default replaces only its own earlier value: an option the user set since (a
+    script between two runs) stays, and the run fingerprint lists it (a restart with other
+    result-changing PETSc options is refused), while the defaults are not listed."""
+    from petsc4py import PETSc
+    from damage_dolfinx.numerics import solvers
+    from damage_dolfinx.runtime.fingerprint import given_options
+    opts = PETSc.Options()
+    try:
+        solvers.set_default_options("mech_", {"ksp_type": "cg", "ksp_rtol": 1e-12})
+        assert given_options() == []
+        opts["mech_ksp_rtol"] = "1e-3"
+        solvers.set_default_options("mech_", {"ksp_type": "cg", "ksp_rtol": 1e-12})
+        assert opts.getString("mech_ksp_rtol") == "1e-3"
+        assert given_options() == [["mech_ksp_rtol", "1e-3"]]
+        opts["mech_ksp_monitor"] = ""  # a diagnostic changes no result
+        assert given_options() == [["mech_ksp_rtol", "1e-3"]]
+    finally:
+        for name in ("mech_ksp_type", "mech_ksp_rtol", "mech_ksp_monitor"):
+            opts.delValue(name)
+            solvers._CODE_DEFAULTS.pop(name, None)

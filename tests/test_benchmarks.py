@@ -5,6 +5,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
@@ -60,3 +61,54 @@ def test_readme_tables_come_from_records():
         assert not typed, (record, typed)
         marked += 1
     assert marked >= 5
+
+
+def _scaling_2d():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(
+        "scaling_2d", BENCH / "performance" / "scaling_2d.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_scaling_2d_report(tmp_path):
+    """The 2-D scaling report from one real tiny run and rows derived from it at sizes of the
+    fit (time per step = c N^1.1 serially, c N^0.9 on 2 ranks): the tables carry every row, the
+    least-squares exponent and the local slopes are the ones put in, a tagged variant is
+    compared with its base run (same answers: difference 0)."""
+    import json
+    script = BENCH / "performance" / "scaling_2d.py"
+    out, record = tmp_path / "out", tmp_path / "record"
+    subprocess.run([sys.executable, str(script), "run", "2.1-ex1", "--n", "10", "--steps", "3",
+                    "--out", str(out)], cwd=REPO, check=True, capture_output=True, timeout=120)
+    runs = out / "runs"
+    real = json.loads((runs / "2.1-ex1_n10_p1_auto.json").read_text())
+    assert real["dofs_u"] > 0 and len(real["step_times_s"]) == 4
+    for example in ("2.1-ex1", "3.1-ex1"):
+        for ranks, power in ((1, 1.1), (2, 0.9)):
+            for i, dofs in enumerate((10_000, 40_000, 160_000, 640_000)):
+                times = [0.1 * (dofs / 1e4) ** power] * 4
+                row = {**real, "example": example, "n": 100 * (i + 1), "ranks": ranks,
+                       "dofs_u": dofs, "step_times_s": times, "step_s": times[-1],
+                       "step_median_s": times[-1]}
+                (runs / f"{example}_n{row['n']}_p{ranks}_auto.json").write_text(json.dumps(row))
+    (runs / "2.1-ex1_n10_p1_auto_same.json").write_text(json.dumps(
+        {**real, "tag": "same", "options": ["-mech_amg_rebuild_its", "0"]}))
+    proc = subprocess.run([sys.executable, str(script), "report", "--out", str(out),
+                           "--record", str(record)], cwd=REPO, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    scaling = (record / "scaling.md").read_text()
+    rows = [line for line in scaling.splitlines() if line.startswith("| ")]
+    assert sum(line.startswith(("| 1 | ", "| 2 | ")) for line in rows) == 17  # 2 x 8 + n = 10
+    assert "| 2.1-ex1 | 1 | 4 | 1e+04 - 6.4e+05 | **1.10** | 1.10 | 1.10, 1.10, 1.10 |" in rows
+    assert "| 3.1-ex1 | 2 | 4 | 1e+04 - 6.4e+05 | **0.90** | 0.90 | 0.90, 0.90, 0.90 |" in rows
+    variants = (record / "variants.md").read_text()
+    assert "| 2.1-ex1 | 1 | 10 |" in variants and "1.00 |" in variants
+    assert "0.0e+00, 0.0e+00" in variants
+    assert (record / "scaling.png").stat().st_size > 0
+    module = _scaling_2d()
+    rows = [{"dofs_u": d, "step_median_s": 2.0 * d ** 1.25} for d in (5e3, 2e4, 8e4, 3.2e5)]
+    assert abs(module.fit(rows) - 1.25) < 1e-12
+    assert np.allclose(module.local_slopes(rows), [1.25, 1.25])

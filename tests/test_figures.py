@@ -144,10 +144,11 @@ def test_convergence_error_label_in_mathtext():
 
 def test_every_plot_goes_through_figstyle():
     """No module draws with matplotlib directly: figure sizes, fonts, mathtext, colour scales and
-    layout come from figstyle."""
+    layout come from figstyle (and figbody, its drawing of a body's edges, fields and guides,
+    reached through figstyle)."""
     import re
     files = list((REPO / "damage_dolfinx").rglob("*.py")) + list((REPO / "benchmarks").rglob("*.py"))
-    direct = [p.name for p in files if p.name != "figstyle.py" and
+    direct = [p.name for p in files if p.name not in ("figstyle.py", "figbody.py") and
               re.search(r"^\s*(import matplotlib|from matplotlib)|\.savefig\(|plt\.subplots",
                         p.read_text(), re.M)]
     assert not direct, direct

@@ -1,7 +1,9 @@
 """The run fingerprint is canonical: the same problem gives the same fingerprint whatever the
 number of ranks, the Python hash seed or how many UFL objects (constants, functions, labels,
 indices) the process made before; a changed law is named as the law, a changed constant of a
-load as the load. A restart on 1 -> 2 -> 3 ranks under different hash seeds is accepted."""
+load as the load, a zeta0(x) changed inside (same range) as zeta0, by a digest of its values at
+the nodes gathered in an order no partition changes. A restart on 1 -> 2 -> 3 ranks under
+different hash seeds is accepted."""
 import json
 import subprocess
 import sys
@@ -49,7 +51,10 @@ SCRIPT = textwrap.dedent('''
     problem = dd.Problem(model="2.2", mesh=mesh, n=3, T=T, k=0.01,
                          boundaries={"clamped": 1, "traction": 2, "tresca": 3},
                          traction=traction, damage_law=dd.DamageLaw(law, "own"),
-                         params={"E": 2000.0, "g_fric": 10.0})
+                         params={"E": 2000.0, "g_fric": 10.0},
+                         # two values only: "zeta0" changes it inside, not its min or max
+                         zeta0=lambda x: 0.5 + 0.5 * (x[0] > (1.5 if variant == "zeta0" else
+                                                              1.0)))
     if what == "fingerprint":
         from damage_dolfinx.runtime import checkpoint
         ex = problem.checked()
@@ -92,6 +97,8 @@ def test_fingerprint_is_the_same_whatever_the_ranks_seed_and_ufl_counts(tmp_path
     assert [key for key in base if base[key] != law[key]] == ["damage_law"]
     load = _fingerprint(tmp_path, 2, 7, 0, "load")
     assert [key for key in base if base[key] != load[key]] == ["traction"]
+    zeta0 = _fingerprint(tmp_path, 3, 8, 0, "zeta0")  # a digest of its nodal values
+    assert [key for key in base if base[key] != zeta0[key]] == ["zeta0"]
 
 
 @pytest.mark.mpi
@@ -104,7 +111,8 @@ def test_restart_on_1_2_3_ranks_with_other_hash_seeds_is_accepted(tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "completed" and summary["steps_done"] == 6
     assert [r["mpi_size"] for r in summary["restarts"]] == [2, 3]
-    for variant, item in (("law", "the damage law differs"), ("load", "the traction differs")):
+    for variant, item in (("law", "the damage law changed"), ("load", "the traction changed"),
+                          ("zeta0", "the initial damage zeta0 changed")):
         proc = _python(tmp_path, 2, 3, "restart", out, 0.08, 1, variant)
         assert proc.returncode == 2, proc.stderr
         lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
@@ -143,11 +151,11 @@ def test_every_level_of_a_study_restart_checks_the_run_fingerprint(tmp_path, cap
     files = {f.name: f.read_bytes() for f in out.iterdir() if f.is_file()}
     again = dd.converge(_study_problem(), out, restart=True, **levels)
     assert again["errors"] == first["errors"] and "nothing to do" in capsys.readouterr().out
-    for problem, line in ((_study_problem(law_factor=2.0), "the damage law differs"),
-                          (_study_problem(wide=2.5), "the mesh differs")):
+    for problem, line in ((_study_problem(law_factor=2.0), "the damage law changed"),
+                          (_study_problem(wide=2.5), "the mesh changed")):
         with pytest.raises(dd.InputError) as info:
             dd.converge(problem, out, restart=True, **levels)
         text = str(info.value)
-        assert text.startswith(f"cannot restart: {line} from the study in ") and \
+        assert text.startswith(f"cannot restart: {line} since the study in ") and \
             "at the reference mesh n = 8" in text and "\n" not in text, text
     assert {f.name: f.read_bytes() for f in out.iterdir() if f.is_file()} == files

@@ -3,7 +3,8 @@
 The models page (docs/models.md) states each model's equations, scheme and the data the thesis
 leaves open; docstrings and comments point there, never to a document outside the repository or
 to a path of the machine the package was written on. The short codes of the defaults (``G3``)
-stay only in the catalogue's ``assumptions`` data, which the report translates.
+stay only in the catalogue's ``assumptions`` data, which a run records in words and the report
+translates.
 """
 import ast
 import io

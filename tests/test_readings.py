@@ -77,3 +77,21 @@ def test_committed_studies_follow_the_default_readings():
             if sub == "convergence-literal":
                 literal_copies.add(s["example"])
     assert literal_copies == evidence_default
+
+
+def test_a_run_records_its_assumptions_in_words():
+    """summary.json's assumptions and reading record carry no short label of the catalogue's:
+    a labelled entry reads ``assumed: ...``; the raw entry keeps its labels (the report reads
+    the assumed layouts from them)."""
+    import json
+
+    from damage_dolfinx import departures
+    from damage_dolfinx.description import in_words
+    label = re.compile(r"\bG\d+[a-z]?\b")
+    assert in_words("1.9/G37: von Mises (G41: unit labels) (G3)") == \
+        "assumed: von Mises (assumed: unit labels) (assumed)"
+    for reading in ("literal", "evidence"):
+        for ex_id, ex in examples.catalogue(reading).items():
+            recorded = json.dumps([ex.assumptions, departures.record(ex)])
+            assert not label.search(recorded), (ex_id, label.search(recorded).group(0))
+    assert any(label.match(a) for a in examples.get("2.1-ex1").literal.assumptions)

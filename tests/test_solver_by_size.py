@@ -49,8 +49,11 @@ def test_amg_above_the_threshold_gives_the_direct_answer(example, tmp_path):
             assert diff < 1e-8, (example, np_, name, diff)
 
 
-def test_bad_threshold_is_refused(tmp_path):
+@pytest.mark.parametrize("options, name", [
+    (["-mech_amg_min_dofs", "many"], "-mech_amg_min_dofs"),
+    (["-mech_amg_min_dofs", "0", "-mech_amg_rebuild_its", "-3"], "-mech_amg_rebuild_its")])
+def test_bad_threshold_is_refused(tmp_path, options, name):
     proc = run_cli(["run", "2.1-ex1", "--n", "5", "--T", "0.02", "--no-figures", "--quiet",
-                    "--out", tmp_path / "bad", "-mech_amg_min_dofs", "many"], check=False)
+                    "--out", tmp_path / "bad", *options], check=False)
     assert proc.returncode == 2
-    assert "-mech_amg_min_dofs must be a whole number" in proc.stderr
+    assert f"{name} must be a whole number" in proc.stderr

@@ -5,6 +5,7 @@ solver choice (``damage_dolfinx/numerics/scalable.py``, ``AMG_MIN_DOFS``) was ch
 difference between the two solvers' answers.
 
     .venv/bin/python benchmarks/performance/scaling_2d.py run 2.1-ex1 --n 160 [--ranks 2] [--mode amg]
+        [--tag rebuild --options '-mech_amg_rebuild_its 0']
     .venv/bin/python benchmarks/performance/scaling_2d.py report
 
 ``run`` measures one size (one ``damage-dolfinx run`` of a few steps, figures and field output
@@ -15,13 +16,17 @@ Modes: ``auto`` (the package's rule), ``direct`` (every system factorised:
 ``-<prefix>amg_min_dofs`` above any size), ``amg`` (every system of the rule on CG + AMG:
 ``-<prefix>amg_min_dofs 0``).
 
-Time per step: the mean of history.csv's ``step_time_s`` over the steps after the first (the
-first sets up factorisations and AMG hierarchies; it is listed apart), the fastest beside it.
+Time per step: the median of history.csv's ``step_time_s`` over the steps after the first (the
+first sets up factorisations and AMG hierarchies; it is listed apart), the mean (which carries
+the occasional re-factorisation of 2.1's lagged elasticity solver) and the range beside it.
 The cost of a 100-step run: step 0 (the t = 0 state) + step 1 + 99 later steps.
-``report`` writes ``scaling.md`` (per example and ranks, the rule's runs, exponent fitted from
-1e4 unknowns up), ``crossover.md`` (direct against AMG per size) and ``difference.md`` (u and
-zeta of the two solvers, relative, at the sizes where both ran) from all JSON files present,
-plus ``scaling.png``.
+``report`` writes ``scaling.md`` (per example and ranks, the rule's runs; the exponent of the
+time per step against the unknowns, least squares on log-log from 1e4 to 1.2e6 unknowns, and the
+local slopes between neighbouring sizes), ``crossover.md`` (direct against AMG per size),
+``difference.md`` (u and zeta of the two solvers, relative, at the sizes where both ran) and
+``variants.md`` (each run with ``--tag NAME --options '...'``, a solver option set, against the
+untagged run of the same size: time per step, iterations, the answers' difference) from all JSON
+files present, plus ``scaling.png``.
 """
 from __future__ import annotations
 
@@ -54,6 +59,8 @@ MODES = ("auto", "direct", "amg")
 #: a size above any mesh: ``direct`` factorises every system
 NEVER = 10 ** 15
 FIT_FROM_DOFS = 1e4
+#: the largest size of the fit (the goal is stated from 1e4 to 1e6 unknowns)
+FIT_TO_DOFS = 1.2e6
 RUN_STEPS = 100  # the run length of the crossover's cost
 
 
@@ -65,13 +72,19 @@ def mode_options(example: str, mode: str) -> list:
     return [tok for p in prefixes for tok in (f"-{p}amg_min_dofs", value)]
 
 
-def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Path) -> dict:
+def run_name(example: str, n: int, ranks: int, mode: str, tag: str = "") -> str:
+    """``<example>_n<n>_p<ranks>_<mode>[_<tag>]``: the name of a run's JSON and folder."""
+    return f"{example}_n{n}_p{ranks}_{mode}" + (f"_{tag}" if tag else "")
+
+
+def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Path,
+            options=(), tag: str = "") -> dict:
     k, args, _, columns = EXAMPLES[example]
-    run = folder / f"{example}_n{n}_p{ranks}_{mode}"
+    run = folder / run_name(example, n, ranks, mode, tag)
     cmd = ["/usr/bin/time", "-f", "peak_rss_kb=%M", sys.executable, "-m", "damage_dolfinx.cli",
            "run", example, "--n", str(n), "--k", f"{k:g}", "--T", f"{k * steps:.12g}", *args,
            "--no-figures", "--quiet", "--write-every", str(10 ** 6), "--checkpoint-seconds",
-           "0", "--overwrite", "--out", str(run), *mode_options(example, mode)]
+           "0", "--overwrite", "--out", str(run), *mode_options(example, mode), *options]
     if ranks > 1:
         cmd = ["mpirun", "-n", str(ranks)] + cmd
     start = time.perf_counter()
@@ -88,10 +101,12 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
            for c in columns}
     rss = [int(v) / 1024.0 for v in re.findall(r"peak_rss_kb=(\d+)", proc.stderr)]
     mesh = summary["mesh"]
-    return {"example": example, "n": n, "ranks": ranks, "mode": mode, "k": k, "steps": steps,
+    return {"example": example, "n": n, "ranks": ranks, "mode": mode, "tag": tag,
+            "options": list(options), "k": k, "steps": steps,
             "dofs_u": mesh["dofs_u"], "dofs_zeta": mesh["dofs_zeta"],
             "command": " ".join(cmd[3:]) if ranks == 1 else " ".join(cmd),
             "step_times_s": times, "step_s": float(np.mean(later)),
+            "step_median_s": float(np.median(later)),
             "step_min_s": float(np.min(later)), "start_s": times[0], "first_step_s": times[1],
             "run100_s": times[0] + times[1] + (RUN_STEPS - 1) * float(np.mean(later)),
             "timings_s": summary.get("timings_s", {}), "iterations": summary.get("iterations"),
@@ -102,17 +117,32 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
 
 
 def load(out: Path) -> list:
-    return sorted((json.loads(p.read_text()) for p in (out / "runs").glob("*.json")),
-                  key=lambda r: (r["example"], r["ranks"], r["mode"], r["dofs_u"]))
+    rows = [json.loads(p.read_text()) for p in (out / "runs").glob("*.json")]
+    for r in rows:  # the per-step median and tag (records written before they were stored)
+        r.setdefault("step_median_s", float(np.median(r["step_times_s"][2:])))
+        r.setdefault("tag", "")
+    return sorted(rows, key=lambda r: (r["example"], r["ranks"], r["mode"], r["dofs_u"]))
 
 
-def fit(rows, key="step_s") -> float:
-    """Exponent a of key = c dofs_u^a over the sizes from FIT_FROM_DOFS unknowns on."""
-    big = [r for r in rows if r["dofs_u"] >= FIT_FROM_DOFS]
+def in_fit(rows) -> list:
+    """The rows inside the fitted range, FIT_FROM_DOFS to FIT_TO_DOFS unknowns."""
+    return [r for r in rows if FIT_FROM_DOFS <= r["dofs_u"] <= FIT_TO_DOFS]
+
+
+def fit(rows, key="step_median_s") -> float:
+    """Exponent a of key = c dofs_u^a, least squares on log-log over the sizes of in_fit."""
+    big = in_fit(rows)
     if len(big) < 2:
         return float("nan")
     return float(np.polyfit(np.log([r["dofs_u"] for r in big]),
                             np.log([r[key] for r in big]), 1)[0])
+
+
+def local_slopes(rows, key="step_median_s") -> list:
+    """log(t2 / t1) / log(N2 / N1) between neighbouring sizes of in_fit, in order of size."""
+    big = sorted(in_fit(rows), key=lambda r: r["dofs_u"])
+    return [float(np.log(b[key] / a[key]) / np.log(b["dofs_u"] / a["dofs_u"]))
+            for a, b in zip(big, big[1:])]
 
 
 def its_text(values) -> str:
@@ -126,34 +156,56 @@ def _dofs(value) -> str:
     return f"{value:,}".replace(",", " ")
 
 
+def _factorisations(r) -> str:
+    its = r.get("iterations") or {}
+    value = its.get("mech_factorizations")
+    return "-" if value is None else str(value)
+
+
 def scaling_table(rows, mode="auto") -> list:
+    """Per example: one row per ranks and size (the rule's runs), then the exponents."""
     lines = []
     for example in EXAMPLES:
         columns = EXAMPLES[example][3]
         sel = [r for r in rows if r["example"] == example and r["mode"] == mode]
         if not sel:
             continue
-        head = ["ranks", "n", "dofs u", "dofs total", "time/step [s] mean (fastest)",
-                "first step [s]", *columns.values(), "split per step [s]", "peak RSS/rank [MB]"]
+        head = ["ranks", "n", "dofs u", "dofs total", "time/step [s] median (min-max)",
+                "mean [s]", "first step [s]", "factorisations", *columns.values(),
+                "peak RSS/rank [MB]"]
         lines += [f"**{example}** (k = {sel[0]['k']:g}, {sel[0]['steps']} steps, {mode})", "",
                   "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         for r in sel:
-            split = ", ".join(f"{key} {value / r['steps']:.3g}"
-                              for key, value in r["timings_s"].items() if key != "stability")
+            later = r["step_times_s"][2:]
             cells = [r["ranks"], r["n"], _dofs(r["dofs_u"]), _dofs(r["dofs_u"] + r["dofs_zeta"]),
-                     f"{r['step_s']:.3g} ({r['step_min_s']:.3g})", f"{r['first_step_s']:.3g}",
-                     *(its_text(r["its"][c]) for c in columns), split,
+                     f"{r['step_median_s']:.3g} ({min(later):.3g}-{max(later):.3g})",
+                     f"{r['step_s']:.3g}", f"{r['first_step_s']:.3g}", _factorisations(r),
+                     *(its_text(r["its"][c]) for c in columns),
                      f"{max(r['peak_rss_mb_per_rank'] or [float('nan')]):.0f}"]
             lines.append("| " + " | ".join(str(c) for c in cells) + " |")
         lines.append("")
+    return lines + exponent_table(rows, mode)
+
+
+def exponent_table(rows, mode="auto") -> list:
+    """Exponent of the time per step against the unknowns u, per example and ranks: least
+    squares on log-log over FIT_FROM_DOFS..FIT_TO_DOFS (of the median and of the mean), and the
+    local slopes of the median between neighbouring sizes."""
+    head = ["example", "ranks", "sizes", "dofs u", "exponent (median)", "exponent (mean)",
+            "local slopes (median), small to large"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for example in EXAMPLES:
+        sel = [r for r in rows if r["example"] == example and r["mode"] == mode]
         for ranks in sorted({r["ranks"] for r in sel}):
             part = [r for r in sel if r["ranks"] == ranks]
-            span = [r["dofs_u"] for r in part if r["dofs_u"] >= FIT_FROM_DOFS]
-            if span:
-                lines.append(f"{example}, {ranks} rank(s): exponent of time per step against "
-                             f"dofs u, {min(span):.3g} to {max(span):.3g}: **{fit(part):.2f}**  ")
-        lines.append("")
-    return lines
+            span = [r["dofs_u"] for r in in_fit(part)]
+            if len(span) < 2:
+                continue
+            slopes = ", ".join(f"{s:.2f}" for s in local_slopes(part))
+            cells = [example, ranks, len(span), f"{min(span):.3g} - {max(span):.3g}",
+                     f"**{fit(part):.2f}**", f"{fit(part, 'step_s'):.2f}", slopes]
+            lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+    return lines + [""]
 
 
 def crossover_table(rows) -> list:
@@ -211,6 +263,46 @@ def difference(rows) -> list:
     return lines
 
 
+def field_difference(a: dict, b: dict) -> dict:
+    """name -> (max, l2) relative difference of the final nodal fields u and zeta of runs a
+    and b (b against a); empty when a folder lacks its fields."""
+    files = [Path(r["folder"]) / "fields_final.npz" for r in (a, b)]
+    if not all(f.exists() for f in files):
+        return {}
+    fa, fb = (sorted_fields(f, ["u", "zeta"]) for f in files)
+    out = {}
+    for name in ("u", "zeta"):
+        x, y = fa[name][1], fb[name][1]
+        out[name] = (float(np.abs(x - y).max() / np.abs(x).max()),
+                     float(np.linalg.norm(x - y) / np.linalg.norm(x)))
+    return out
+
+
+def variants_table(rows) -> list:
+    """Each tagged run (a solver option set) against the untagged run of the same example,
+    size, ranks and mode: time per step, first step, iterations and the answers' difference."""
+    base = {(r["example"], r["n"], r["ranks"], r["mode"]): r for r in rows if not r["tag"]}
+    head = ["example", "ranks", "n", "dofs u", "variant (options)",
+            "time/step median [s] base / variant", "ratio", "first step [s] base / variant",
+            "CG its base / variant", "u, zeta: rel. diff. max"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        b = base.get((r["example"], r["n"], r["ranks"], r["mode"]))
+        if not r["tag"] or b is None:
+            continue
+        col = next(iter(EXAMPLES[r["example"]][3]))
+        diff = field_difference(b, r)
+        cells = [r["example"], r["ranks"], r["n"], _dofs(r["dofs_u"]),
+                 f"{r['tag']} (`{' '.join(r['options'])}`, {r['mode']})",
+                 f"{b['step_median_s']:.3g} / {r['step_median_s']:.3g}",
+                 f"{r['step_median_s'] / b['step_median_s']:.2f}",
+                 f"{b['first_step_s']:.3g} / {r['first_step_s']:.3g}",
+                 f"{its_text(b['its'][col])} / {its_text(r['its'][col])}",
+                 ", ".join(f"{v[0]:.1e}" for v in diff.values()) or "-"]
+        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+    return lines
+
+
 def plot(rows, path: Path):
     from damage_dolfinx.viz import figstyle
     fig, axes = figstyle.plt().subplots(1, len(EXAMPLES), figsize=(11, 4))
@@ -223,13 +315,13 @@ def plot(rows, path: Path):
                 continue
             d = [r["dofs_u"] for r in sel]
             label = {"auto": "package rule", "direct": "direct only"}[mode]
-            ax.loglog(d, [r["step_s"] for r in sel], style[:-2], color=style[-2:],
+            ax.loglog(d, [r["step_median_s"] for r in sel], style[:-2], color=style[-2:],
                       label=f"{label}, {ranks} rank(s): slope {fit(sel):.2f}")
         sel = [r for r in rows if r["example"] == example and r["mode"] == "auto"
                and r["ranks"] == 1]
         if sel:
             ref = np.array([sel[0]["dofs_u"], sel[-1]["dofs_u"]], float)
-            ax.loglog(ref, sel[0]["step_s"] * ref / ref[0], color="0.6", lw=0.8,
+            ax.loglog(ref, sel[0]["step_median_s"] * ref / ref[0], color="0.6", lw=0.8,
                       label="slope 1")
         ax.set_xlabel("displacement / velocity unknowns")
         ax.set_ylabel("time per step [s]")
@@ -239,17 +331,19 @@ def plot(rows, path: Path):
 
 
 def report(out: Path, record: Path):
-    rows = load(out)
+    every = load(out)
+    rows = [r for r in every if not r["tag"]]
     record.mkdir(parents=True, exist_ok=True)
     stamp = f"{time.strftime('%Y-%m-%d')}, commit {commit()}"
     (record / "scaling.md").write_text("\n".join(
         [f"<!-- {stamp}; scaling_2d.py report -->", ""] + scaling_table(rows)) + "\n")
     (record / "crossover.md").write_text("\n".join(crossover_table(rows)) + "\n")
     (record / "difference.md").write_text("\n".join(difference(rows)) + "\n")
+    (record / "variants.md").write_text("\n".join(variants_table(every)) + "\n")
     (record / "runs.json").write_text(json.dumps(
-        [{k: v for k, v in r.items() if k != "folder"} for r in rows], indent=1))
+        [{k: v for k, v in r.items() if k != "folder"} for r in every], indent=1))
     plot(rows, record / "scaling.png")
-    for name in ("scaling.md", "crossover.md", "difference.md"):
+    for name in ("scaling.md", "crossover.md", "difference.md", "variants.md"):
         print((record / name).read_text())
 
 
@@ -263,6 +357,10 @@ def main(argv=None):
     one.add_argument("--mode", choices=MODES, default="auto")
     one.add_argument("--steps", type=int, default=6)
     one.add_argument("--force", action="store_true")
+    one.add_argument("--tag", default="", help="name of a variant (a solver option set): its "
+                     "runs are compared with the untagged run of the same size")
+    one.add_argument("--options", default="", help="PETSc options of the variant, one string, "
+                     "e.g. '-mech_amg_rebuild_its 0'")
     rep = sub.add_parser("report", help="tables, fit and plot from the measured runs")
     rep.add_argument("--record", default=str(REPO / "benchmarks" / "reference_output"
                                              / "scaling_2d"))
@@ -273,11 +371,13 @@ def main(argv=None):
     if args.command == "report":
         report(out, Path(args.record))
         return
-    target = out / "runs" / f"{args.example}_n{args.n}_p{args.ranks}_{args.mode}.json"
+    target = out / "runs" / (run_name(args.example, args.n, args.ranks, args.mode, args.tag)
+                             + ".json")
     if target.exists() and not args.force:
         print(f"kept {target}")
         return
-    row = measure(args.example, args.n, args.ranks, args.mode, args.steps, out / "folders")
+    row = measure(args.example, args.n, args.ranks, args.mode, args.steps, out / "folders",
+                  args.options.split(), args.tag)
     target.parent.mkdir(parents=True, exist_ok=True)
     target.write_text(json.dumps(row, indent=1))
     print(json.dumps({k: row[k] for k in ("example", "n", "ranks", "mode", "dofs_u", "step_s",

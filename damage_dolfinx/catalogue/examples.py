@@ -1,8 +1,9 @@
 """Catalogue of the thesis examples by id (``2.1-ex1`` ...): data, geometry, scheme, defaults.
 
 Every value the thesis leaves open is an explicit assumption, listed in the example's
-``assumptions`` and copied into each run's summary.json; docs/models.md gives the reasons, model
-by model. An example is a run description (:mod:`damage_dolfinx.description`) with the thesis's
+``assumptions`` and copied into each run's summary.json, its short label written out as
+"assumed" (:func:`damage_dolfinx.description.in_words`); docs/models.md gives the reasons,
+model by model. An example is a run description (:mod:`damage_dolfinx.description`) with the thesis's
 metadata; this module only collects them by id.
 """
 from __future__ import annotations

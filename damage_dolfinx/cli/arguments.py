@@ -38,7 +38,8 @@ def _parser():
         sp.add_argument("--allow-long", action="store_true",
                         help="allow more than 10^7 time steps")
         sp.add_argument("--friction-solver", choices=("newton", "uzawa", "penalty-duality"),
-                        help="Tresca solver of Sections 2.2/2.4/3.2 (same as --set friction_solver=...)")
+                        help="Tresca solver of Sections 2.2/2.4/3.2 "
+                             "(same as --set friction_solver=...)")
         sp.add_argument("--friction-law", choices=("tresca", "coulomb"),
                         help="Section 2.4: Tresca (P1) or simplified Coulomb (P2) "
                              "(same as --set friction_law=...)")

@@ -320,7 +320,7 @@ class FullyDamageableContact(Model):
 
     def summary_extra(self) -> dict:
         out = {"k": self.k, "elastic_term": self.elastic_term + (
-            "" if self.elastic_term == "explicit" else " (G33 deviation, not the thesis scheme)")}
+            "" if self.elastic_term == "explicit" else " (our option, not the thesis scheme)")}
         if self.stability:
             out.update(k_max=self.stability["k_max"], k_over_k_max=self.stability["k_over_k_max"],
                        k_max_lower_bound=self.stability.get("k_max_lower_bound"),

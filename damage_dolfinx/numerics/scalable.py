@@ -37,6 +37,9 @@ DIRECT_MAX_DOFS_3D = AMG_MIN_DOFS[3]
 MECH_AMG_REBUILD_ITS = 40
 #: the PETSc option (after the solver's prefix) that replaces AMG_MIN_DOFS for that solver
 MIN_DOFS_OPTION = "amg_min_dofs"
+#: the PETSc option (after the prefix) that replaces MECH_AMG_REBUILD_ITS (0: a new AMG set-up
+#: every solve, for measurements)
+REBUILD_ITS_OPTION = "amg_rebuild_its"
 
 
 def has_hypre() -> bool:
@@ -83,10 +86,22 @@ def amg_min_dofs(dim: int, prefix: str = "") -> int:
     """The threshold of :func:`iterative` for a solver with options prefix ``prefix``:
     ``-<prefix>amg_min_dofs N`` where given, else ``AMG_MIN_DOFS[dim]``. A value that is no
     whole number >= 0 is an InputError."""
-    name = prefix + MIN_DOFS_OPTION
+    return _whole_option(prefix, MIN_DOFS_OPTION, AMG_MIN_DOFS[dim], "unknowns")
+
+
+def amg_rebuild_its(prefix: str = "") -> int:
+    """CG iterations above which a lagged AMG hierarchy is rebuilt: ``-<prefix>amg_rebuild_its
+    N`` where given, else ``MECH_AMG_REBUILD_ITS``; 0 sets AMG up afresh at every solve."""
+    return _whole_option(prefix, REBUILD_ITS_OPTION, MECH_AMG_REBUILD_ITS, "iterations")
+
+
+def _whole_option(prefix: str, option: str, default: int, what: str) -> int:
+    """``-<prefix><option> N`` (a whole number >= 0) where given, else ``default``; any other
+    value is an InputError."""
+    name = prefix + option
     opts = PETSc.Options()
     if not prefix or not opts.hasName(name):
-        return AMG_MIN_DOFS[dim]
+        return default
     raw = opts.getString(name, "")  # read: PETSc counts the option as used
     try:
         value = float(raw)
@@ -94,7 +109,7 @@ def amg_min_dofs(dim: int, prefix: str = "") -> int:
         value = float("nan")
     if not (value >= 0 and value == int(value)):
         from damage_dolfinx.parameters import InputError
-        raise InputError(f"-{name} must be a whole number of unknowns >= 0, got {raw!r}")
+        raise InputError(f"-{name} must be a whole number of {what} >= 0, got {raw!r}")
     return int(value)
 
 
@@ -108,7 +123,7 @@ def iterative(V, prefix: str = "") -> bool:
 def mech_config(V, direct_defaults, direct_refactor_its, prefix: str = "mech_"):
     """(defaults, refactor_after_its) of an elasticity LinearSolver on V."""
     if iterative(V, prefix):
-        return MECH_AMG, MECH_AMG_REBUILD_ITS
+        return MECH_AMG, amg_rebuild_its(prefix)
     return direct_defaults, direct_refactor_its
 
 

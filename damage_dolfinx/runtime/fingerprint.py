@@ -16,6 +16,11 @@ UFL objects before. Here
     hash(operator) = its type and its operands' hashes, sorted for a sum or a product,
 
 plus the values UFL's signature leaves out: those of constants and a digest of functions'.
+Nodal data (the mesh's node coordinates and cell midpoints, a zeta0(x)'s values) are hashed
+after gathering them on rank 0, duplicates (ghosts) removed and sorted by coordinates
+(``nodal_digest``): 1, 2 or 3 ranks give the same digest, so a restart on another number of
+ranks is accepted. The PETSc options the user gave to the package's solvers are an item too
+(their defaults, which depend on the number of ranks, and diagnostics are not).
 """
 from __future__ import annotations
 
@@ -28,26 +33,31 @@ from mpi4py import MPI
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.runtime import io
 
-#: the fingerprint's format: the loads' and laws' hashes of another version are not compared
-VERSION = 2
+#: the fingerprint's format: the loads' and laws' hashes (and a zeta0 function's digest) of
+#: another version are not compared
+VERSION = 3
 
 #: how the items of the fingerprint are named in a refusal (in the order they are compared)
-ITEMS = {"mesh": "the mesh", "traction": "the traction", "body_force": "the body force",
+ITEMS = {"mesh": "the mesh", "mesh_nodes": "the mesh's nodes or cells",
+         "traction": "the traction", "body_force": "the body force",
          "damage_law": "the damage law", "zeta0": "the initial damage zeta0",
          "boundaries": "the boundary parts", "irreversible": "irreversibility",
-         "reading": "the reading", "builders": "the model's own data (builders)"}
+         "reading": "the reading", "builders": "the model's own data (builders)",
+         "options": "the PETSc options given"}
 #: items hashed from UFL (compared only between fingerprints of the same VERSION)
 UFL_ITEMS = ("traction", "body_force", "damage_law")
+#: PETSc options that change no result (diagnostics), left out of the fingerprint
+_DIAGNOSTIC = ("monitor", "view", "converged_reason", "log", "test")
 
 
 def fingerprint(ex, data) -> dict:
     """The fingerprint of the run of ``ex`` on ``data`` (the problem on its mesh,
     Problem.problem_data): the mesh
-    (cells, vertices, bounding box, facet tags by count), the loads and the damage law by the
-    canonical hash of the UFL they build on this mesh (their literals and constants' values
-    included: a traction 100 times larger changes it), the initial damage, the boundary parts,
-    irreversibility, the reading and the model's own data (builders). Collective on the mesh's
-    ranks."""
+    (cells, vertices, bounding box, facet tags by count; a digest of its nodes and cells), the
+    loads and the damage law by the canonical hash of the UFL they build on this mesh (their
+    literals and constants' values included: a traction 100 times larger changes it), the
+    initial damage, the boundary parts, irreversibility, the reading, the model's own data
+    (builders) and the PETSc options given. Collective on the mesh's ranks."""
     import ufl
     from dolfinx import fem
     from damage_dolfinx.meshes import tag_counts
@@ -63,7 +73,8 @@ def fingerprint(ex, data) -> dict:
            "mesh": f"{msh.topology.index_map(tdim).size_global} cells, "
                    f"{msh.topology.index_map(0).size_global} vertices, box "
                    f"{np.round(lo, 9).tolist()}-{np.round(hi, 9).tolist()}, tags "
-                   f"{sorted(tag_counts(data.geometry).items())}"}
+                   f"{sorted(tag_counts(data.geometry).items())}",
+           "mesh_nodes": mesh_digest(msh)}
     x = ufl.SpatialCoordinate(msh)
     t = fem.Constant(msh, 0.0)
     for name in ("traction", "body_force"):
@@ -73,12 +84,11 @@ def fingerprint(ex, data) -> dict:
     e, z = ufl.sym(ufl.outer(x, x)), x[0] * 0 + t + 1.0
     out["damage_law"] = f"{getattr(law, 'name', '?')} {ufl_hash(law(e, z, data.params))}"
     z0 = data.zeta0
-    if callable(z0):
+    if callable(z0):  # its values at the nodes, in an order no partition changes
         pts = np.ascontiguousarray(msh.geometry.x.T)
         values = np.asarray(z0(pts[:gdim] if gdim < 3 else pts), dtype=float).reshape(-1)
-        digest = [comm.allreduce(float(values.min()) if values.size else np.inf, op=MPI.MIN),
-                  comm.allreduce(float(values.max()) if values.size else -np.inf, op=MPI.MAX)]
-        out["zeta0"] = f"function of x in [{digest[0]:.9g}, {digest[1]:.9g}]"
+        out["zeta0"] = "function of x, nodal digest " + nodal_digest(
+            comm, msh.geometry.x[:, :gdim], values)
     else:
         out["zeta0"] = float(z0)
     out["boundaries"] = repr(sorted((str(k), _tags(v))
@@ -87,6 +97,7 @@ def fingerprint(ex, data) -> dict:
     out["reading"] = getattr(ex, "reading", None)
     out["builders"] = repr(sorted((str(k), repr(v) if not callable(v) else "function")
                                   for k, v in (data.builders or {}).items()))
+    out["options"] = given_options()
     return json.loads(io.strict_json(out))
 
 
@@ -100,6 +111,8 @@ def first_difference(saved, now):
     for key in ITEMS:
         if key in UFL_ITEMS and not same_version:
             continue
+        if key == "zeta0" and not same_version and isinstance(saved.get(key), str):
+            continue  # a function's earlier digest (its range)
         if key in saved and saved.get(key) != now.get(key):
             return key, saved.get(key), now.get(key)
     return None
@@ -112,10 +125,77 @@ def verify_fingerprint(ex, stepper, meta, out) -> dict:
     differ = first_difference((meta or {}).get("fingerprint"), fp)
     if differ:
         key, saved, now = differ
-        raise InputError(f"cannot restart: {ITEMS[key]} differs from the run in "
+        raise InputError(f"cannot restart: {ITEMS[key]} changed since the run in "
                          f"{str(out)!r} (checkpoint: {saved!r}, this run: {now!r}); choose "
                          "another --out to run it")
     return fp
+
+
+def sweep_fingerprint(ex, out, n, k, T, values, comm) -> dict:
+    """The fingerprint shared by every point of a sweep (built at one point: the parameters are
+    compared as the grid); InputError naming the first item that changed when ``out`` holds
+    a sweep of an earlier fingerprint (its finished points would be kept as this sweep's)."""
+    from pathlib import Path
+    fp = fingerprint(ex, ex.problem_data(comm, n=n, k=k, T=T, overrides=dict(values)))
+    saved = None
+    if comm.rank == 0:
+        try:
+            saved = json.loads((Path(out) / "points.json").read_text()).get("fingerprint")
+        except (OSError, ValueError, AttributeError):
+            saved = None
+    differ = first_difference(comm.bcast(saved, root=0), fp)
+    if differ:
+        key, was, now = differ
+        raise InputError(f"cannot run the sweep into {str(out)!r}: {ITEMS[key]} changed since "
+                         f"its points were run (sweep: {was!r}, this sweep: {now!r}); choose "
+                         "another out folder")
+    return fp
+
+
+# ---------------------------------------------------------------------------- nodal digests
+def nodal_digest(comm, coords, values=None) -> str:
+    """A hash of points (and values at them) that no partition changes: every rank's rows
+    (ghost copies included) gathered on rank 0, rounded to 12 digits, duplicates removed,
+    sorted by coordinates. Collective; the same text on every rank."""
+    rows = np.asarray(coords, dtype=float).reshape(len(coords), -1)
+    if values is not None:
+        rows = np.column_stack([rows, np.asarray(values, dtype=float).reshape(len(rows), -1)])
+    gathered = comm.gather(np.round(rows, 12) + 0.0, root=0)  # + 0.0: no negative zero
+    digest = None
+    if comm.rank == 0:
+        every = np.unique(np.concatenate(gathered), axis=0)  # sorted rows, ghosts once
+        digest = hashlib.sha1(np.ascontiguousarray(every).tobytes()).hexdigest()[:16]
+    return comm.bcast(digest, root=0)
+
+
+def mesh_digest(msh) -> str:
+    """The mesh's node coordinates and cell midpoints (its triangulation), by nodal_digest: a
+    file of the same name with a node moved or a diagonal flipped is another mesh."""
+    from damage_dolfinx import compat
+    gdim = msh.geometry.dim
+    return (nodal_digest(msh.comm, msh.geometry.x[:, :gdim]) + " "
+            + nodal_digest(msh.comm, compat.cell_midpoints(msh)[:, :gdim]))
+
+
+def given_options() -> list:
+    """The PETSc options of the package's solvers that the user set (the command line's
+    -prefix_option value, or the database directly), without the solvers' own defaults (they
+    depend on the number of ranks) and without diagnostics: sorted [name, value] pairs."""
+    import sys
+    if "petsc4py.PETSc" not in sys.modules:
+        return []
+    from petsc4py import PETSc
+    from damage_dolfinx.cli.petsc_options import PETSC_PREFIXES
+    from damage_dolfinx.numerics import solvers
+    given = []
+    for name, value in PETSc.Options().getAll().items():
+        if not name.startswith(PETSC_PREFIXES) or any(d in name for d in _DIAGNOSTIC):
+            continue
+        if name in solvers._CODE_DEFAULTS and \
+                str(solvers._CODE_DEFAULTS[name]).lower() == str(value).lower():
+            continue
+        given.append([name, str(value)])
+    return sorted(given)
 
 
 # ---------------------------------------------------------------------------- canonical UFL
@@ -223,6 +303,8 @@ def _tags(v):
     list of them (numbers as numbers, names as names)."""
     if isinstance(v, (int, np.integer, str)):
         return v if isinstance(v, str) else int(v)
+    if len(v) == 1:  # [2] names the same part as 2
+        return _tags(list(v)[0])
     if all(not isinstance(x, str) for x in v):
         return sorted(map(int, v))
     return sorted(map(str, v))

@@ -64,6 +64,16 @@ class Run(RunRecords):
         r.summary = None
         return r
 
+    #: the caller's code raised inside the loop (Run.abandon): no outputs of a stop
+    abandoned = False
+
+    def abandon(self, steps):
+        """End the generator ``steps`` after the caller's own code raised inside the loop: no
+        outputs of a stop (a rank alone in this may not enter a collective write while the
+        others solve; the exception decides the status, runtime/collective.py)."""
+        self.abandoned = True
+        steps.close()
+
     def steps(self):
         """The run, step by step: yields a :class:`Step` after the initial state and after
         every step; closing the generator stops the run at that step (status "stopped")."""
@@ -209,6 +219,8 @@ class Run(RunRecords):
             try:
                 yield Step(self)
             except GeneratorExit:
+                if self.abandoned:
+                    raise
                 stop = "stopped"
                 if stepper.n < N and self.supported:
                     self.save_checkpoint()
@@ -266,6 +278,8 @@ class Run(RunRecords):
         try:
             yield Step(self)
         except GeneratorExit:  # the caller stopped here: the outputs of a stopping step
+            if self.abandoned:
+                raise
             self._outputs("stopped", (stats, step_time, row), scalars, None)
             return "stopped"
         return None

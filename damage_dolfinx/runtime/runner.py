@@ -76,9 +76,13 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
                     figures, time_limit, checkpoint_every, checkpoint_seconds, restart,
                     overwrite, history_every, comm)
     steps = r.steps()
-    for step in steps:
-        if on_step is not None and on_step(step):
-            steps.close()
+    try:
+        for step in steps:
+            if on_step is not None and on_step(step):
+                steps.close()
+    except BaseException:  # on_step raised (the run's own failures have ended the loop)
+        r.abandon(steps)
+        raise
     return r.summary
 
 

@@ -36,7 +36,7 @@ from damage_dolfinx.studies.convergence_cells import (  # noqa: F401 (SERIAL_CEL
     _error_definition, _norm_statement, _owners)
 
 from damage_dolfinx.studies.convergence_resume import (SCHEMA, check_restart, level_fingerprints,
-                                                       previous_study)
+                                                       outputs_intact, previous_study)
 
 
 def _check_levels(ref_n, ref_k, ns, ks):
@@ -128,7 +128,7 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
     previous = previous_study(out, comm)
     if restart and previous is not None:
         check_restart(previous, settings, out, ref_n)
-        if previous.get("status") == "completed":
+        if previous.get("status") == "completed" and outputs_intact(out, previous, comm):
             if comm.rank == 0:
                 print(f"damage-dolfinx: nothing to do: the study in {str(out)!r} completed "
                       "with these settings; its outputs are unchanged", flush=True)
@@ -139,8 +139,10 @@ def study(example_id, out, ref_n=None, ref_k=None, ns=None, ks=None, T=None, ove
         earlier = claim_folder(out, "study", STUDY_FILES, restart, overwrite, comm,
                                "a convergence study", apply=False)
         if earlier and restart and comm.rank == 0:
-            print(f"damage-dolfinx: the study in {str(out)!r} did not complete and studies keep "
-                  "no checkpoints: it runs again from the start", file=sys.stderr, flush=True)
+            why = "its outputs are damaged" if (previous or {}).get("status") == "completed" \
+                else "it did not complete"
+            print(f"damage-dolfinx: the study in {str(out)!r}: {why} and studies keep no "
+                  "checkpoints: it runs again from the start", file=sys.stderr, flush=True)
         claimed = []
 
         def claim():  # after the set-up: a refused one leaves the folder untouched

@@ -34,6 +34,24 @@ def previous_study(out, comm):
     return comm.bcast(result, root=0)
 
 
+def outputs_intact(out, previous, comm) -> bool:
+    """Whether the completed study in ``out`` still has its outputs as it wrote them (a restart
+    with nothing to do trusts them; else the study runs again and rewrites them): every file of
+    its manifest present, errors.csv whole (a header and one row of as many columns per error
+    in the summary), the others non-empty. Rank 0 looks; every rank gets the answer."""
+    intact = None
+    if comm.rank == 0:
+        try:
+            files = json.loads((out / "manifest.json").read_text()).get("files", [])
+            rows = (out / "errors.csv").read_text().splitlines()
+            intact = (len(rows) == 1 + len(previous.get("errors") or [])
+                      and len({row.count(",") for row in rows}) == 1
+                      and all((out / name).stat().st_size > 0 for name in files))
+        except (OSError, ValueError, AttributeError, TypeError):
+            intact = False
+    return comm.bcast(intact, root=0)
+
+
 def check_restart(previous, settings, out, ref_n):
     """InputError naming the first setting, or at the first level the first fingerprint item,
     that differs between the study in ``out`` (its summary ``previous``) and this one. A summary
@@ -54,6 +72,6 @@ def check_restart(previous, settings, out, ref_n):
             key, was, is_ = differ
             where = f"the reference mesh n = {level}" if level == str(ref_n) else \
                 f"the level n = {level}"
-            raise InputError(f"cannot restart: {ITEMS[key]} differs from the study in "
+            raise InputError(f"cannot restart: {ITEMS[key]} changed since the study in "
                              f"{str(out)!r} at {where} (study: {was!r}, this study: {is_!r}); "
                              "choose another out folder (or overwrite=True) to run it")

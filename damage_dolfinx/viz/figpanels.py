@@ -12,8 +12,10 @@ from .figstyle import PANEL_SUFFIX, render_fields
 
 
 def save_panels(path, panels, **meta):
-    """The data behind a field figure (``<png stem>.panel.npz`` + JSON meta; not ``.npz``, which would overwrite a run's fields_final.npz behind fields_final.png), so that a thesis pair can be
-    re-rendered on a shared stress scale after both runs finished (:func:`render_saved`)."""
+    """The data behind a field figure (``<png stem>.panel.npz`` + JSON meta; not ``.npz``,
+    which would overwrite a run's fields_final.npz behind fields_final.png), so that a thesis
+    pair can be re-rendered on a shared stress scale after both runs finished
+    (:func:`render_saved`)."""
     path = Path(path)
     arrays = {}
     for i, p in enumerate(panels):
@@ -30,7 +32,8 @@ def save_panels(path, panels, **meta):
 def load_panels(npz):
     d = np.load(npz)
     meta = json.loads(str(d["meta"]))
-    panels = [dict(info, xy=d[f"xy{i}"], values=d[f"v{i}"]) for i, info in enumerate(meta["panels"])]
+    panels = [dict(info, xy=d[f"xy{i}"], values=d[f"v{i}"])
+              for i, info in enumerate(meta["panels"])]
     return panels, meta, (d["ref_xy"] if "ref_xy" in d else None)
 
 
