@@ -211,3 +211,27 @@ def test_power_iteration_agrees_with_slepc_with_contact():
     print(power, slepc)
     assert power["k_max"] == pytest.approx(slepc["k_max"], rel=2e-3)
     assert power["omega2_max"] == pytest.approx(slepc["omega2_max"], rel=2e-3)
+
+
+# ------------------------------------------------------------------ (f) the step's scalars
+def test_scalars_equal_assembled_norms():
+    """history.csv's ||u||_L2 (M u_n carried by (3.51) from step to step), ||eps(u)||_L2, ||v||_L2
+    and max |u| equal the assembled integrals and the nodal maximum, also after a step without
+    scalars (a history cadence > 1) and after restore."""
+    st = free_square(0.01, 0.05, traction=lambda x, t: ufl.as_vector((20.0 * t, -20.0 * t)))
+    norm = lambda f: math.sqrt(compat.assemble_scalar(compat.form(f * ufl.dx), COMM))  # noqa: E731
+    st.initialize()
+    st.scalars()
+    for skip in (False, False, True, False, False):
+        st.advance()
+        if skip:
+            continue
+        s = st.scalars()
+        assert s["u_L2"] == pytest.approx(norm(ufl.inner(st.u, st.u)), rel=1e-12)
+        assert s["eps_u_L2"] == pytest.approx(norm(ufl.inner(eps(st.u), eps(st.u))), rel=1e-12)
+        assert s["v_L2"] == pytest.approx(norm(ufl.inner(st.v, st.v)), rel=1e-12)
+        nodes = np.linalg.norm(st.u.x.array.reshape(-1, 2), axis=1).max()
+        assert s["u_max"] == pytest.approx(COMM.allreduce(nodes, op=MPI.MAX), rel=1e-14)
+    st.u.x.array[:] *= 2.0  # a loaded state: M u from u itself
+    st.restore(st.n)
+    assert st.scalars()["u_L2"] == pytest.approx(norm(ufl.inner(st.u, st.u)), rel=1e-12)
