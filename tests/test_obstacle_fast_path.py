@@ -144,39 +144,3 @@ def test_run_to_zeta_star_serial_two_ranks_and_snes(tmp_path):
         print(f"{field} against the SNES alone: {diffs}")
         assert max(diffs.values()) < 1e-10 and diffs["cg"] == 0.0, field
 
-
-def test_cellwise_source_equals_the_assembled_right_hand_side(unit_square):
-    """Variant A with lam_D = 0 (Section 3.3): the source is constant on each cell and l is
-    computed by sparse maps (cellwise_source.py); same l and same step as the assembly, also
-    where Psi_q is capped; lam_D != 0 keeps the assembly."""
-    from types import SimpleNamespace
-    from damage_dolfinx.numerics.constitutive import eps
-    from damage_dolfinx.numerics.damage import source
-    msh = unit_square(12)
-    Z, V = compat.scalar_p1(msh), compat.vector_p1(msh)
-    u_old = fem.Function(V)
-    u_old.interpolate(lambda X: np.vstack([0.3 * np.sin(4 * X[0]) * X[1], 0.2 * X[0] ** 2]))
-    steps = []
-    for lam_D in (0.0, 0.0, 0.5):
-        p = SimpleNamespace(variant="A", lam_D=lam_D, lam_u=40.0, lam_w=0.5, q_star=0.05,
-                            zeta_star=ZETA_STAR)
-        zeta, zeta_old = fem.Function(Z), fem.Function(Z)
-        zeta_old.interpolate(lambda X: 0.6 + 0.3 * X[0] * X[1])
-        steps.append(DamageStep(zeta, zeta_old, source(eps(u_old), zeta_old, p),
-                                fem.Constant(msh, K), fem.Constant(msh, KAPPA),
-                                SolveContext("cw"), obstacle=True, zeta_star=ZETA_STAR,
-                                prefix=f"cw{len(steps)}_"))
-        if len(steps) != 2:
-            assert steps[-1].use_cellwise_source(u_old, p) == (lam_D == 0.0)
-    mapped, assembled = steps[0], steps[1]
-    print(f"set-up check {mapped.cellwise_check:.1e}")
-    assert mapped.cellwise_check < 1e-13
-    for s in (mapped, assembled):
-        s.solve()
-    phi_c = mapped._cellwise.phi.array  # -0.5 lam_u min(|eps_c|^2, q_star) - lam_w per cell
-    n_capped = msh.comm.allreduce(int(np.sum(phi_c == -0.5 * 40.0 * 0.05 - 0.5)), op=MPI.SUM)
-    diff_l = mapped.b.copy()
-    diff_l.axpy(-1.0, assembled.b)
-    rel = diff_l.norm() / assembled.b.norm()
-    print(f"{n_capped} cells capped; l: {rel:.1e}; zeta: {_max_diff(mapped, assembled, msh.comm):.1e}")
-    assert n_capped > 10 and rel < 1e-14 and _max_diff(mapped, assembled, msh.comm) < 1e-13

@@ -146,8 +146,7 @@ def examples():
         title="ring wrench on a stiff hexagonal screw, cyclic pressure 1e5 sqrt(2)|sin(pi t)| "
               "on the end of the handle",
         params=_params(7.1e9, 0.33, 2700.0, 1.5e3, 1e9, 1e6, math.inf, False,
-                       history_every=HISTORY_EVERY_EX3, damage_atol_rel=0.0,
-                       damage_source_map=True),
+                       history_every=HISTORY_EVERY_EX3, damage_atol_rel=0.0),
         T=6.5, k=K_EX3, h=0.15, diameter=math.hypot(11.2, 2.4),
         mesh=lambda comm, n, h: wrench(comm, h=h, h_contact=h / 3),
         model="3.3",
@@ -175,9 +174,6 @@ def examples():
             "step's absolute tolerance is snes_atol = 1e-12, not 1e-9 ||l||, which kept zeta "
             "unchanged whenever the increment's residual was smaller: on the wrench the damage "
             "of t < 0.3 and of many steps up to t = 1.4)",
-            "damage right-hand side by sparse maps (damage_source_map: the source is constant "
-            "on every cell for variant A with lam_D = 0 on P1; checked against the assembly "
-            "at set-up)",
             "history.csv: a row every history_every = 50 steps; the maximal "
             "interpenetration over all steps (summary.json max_penetration) is tracked at "
             "every step",

@@ -126,11 +126,6 @@ class FullyDamageableContact(Model):
                 if not float(rel) >= 0.0:
                     raise InputError(f"damage_atol_rel must be >= 0, got {rel!r}")
                 self.damage.atol_rel = float(rel)
-            # ``damage_source_map`` (the wrench): the damage right-hand side by sparse
-            # maps where the source is constant on every cell (damage.use_cellwise_source; it
-            # checks itself against the assembly and keeps the assembly otherwise)
-            if x.get("damage_source_map"):
-                self.damage.use_cellwise_source(self.u_old, self.params)
 
         # (3.159): velocity with the new damage in the viscosity
         tags = data.geometry.facet_tags

@@ -31,7 +31,6 @@ from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
-from damage_dolfinx.numerics.cellwise_stress import MemoryIntegrand
 from damage_dolfinx.numerics.memory import MemoryKernel, MemoryTerm
 from damage_dolfinx.parameters import InputError
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
@@ -96,15 +95,6 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         self.memory = MemoryTerm(msh, kernel, k, x.get("memory_mode", "auto"))
         self._g_expr = compat.expression(
             memory_integrand(self.u, self.zeta, p.E, p.nu, p.L_trunc), self.memory.space)
-        # g by the cell stress map S u (cellwise_stress.py, checked against the
-        # interpolation at construction; P1 u on simplices): 0.9 ms of 3.8 per step at 4k dofs
-        self._g_map = None
-        if compat.element_degree(V) == 1:
-            try:
-                self._g_map = MemoryIntegrand(self.memory.g, self.u, self.zeta, p.E, p.nu,
-                                              p.L_trunc, self._g_expr)
-            except RuntimeError:  # the map differs from the interpolation: keep the latter
-                pass
 
         # (2.137): nonlinear displacement step
         tags = data.geometry.facet_tags
@@ -156,7 +146,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         and the displacement (2.137) by semismooth Newton."""
         damage_prefix, mech_prefix = self._prefixes
         return (SubStep("memory", "update", "",                                    # (2.136)
-                        partial(self.memory.update, self._g_map or self._g_expr)),
+                        partial(self.memory.update, self._g_expr)),
                 SubStep("damage", "linear", damage_prefix, self.damage.solve,      # (1.5)
                         its=("damage_its",)),
                 SubStep("mech", "semismooth", mech_prefix, self.mech.solve,        # (2.137)

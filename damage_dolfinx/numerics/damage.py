@@ -113,25 +113,8 @@ class DamageStep:
         self.fast = ObstacleFastPath(self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
                                      CHOLESKY_MAX_DOFS[V.mesh.topology.dim]) \
             if enabled and obstacle and not irreversible else None  # scalar bounds only
-        self.k, self._cellwise = k, None
         self._atol_set, self._rtol, self._vecs = None, None, None
         self._parallel = V.mesh.comm.size > 1
-
-    def use_cellwise_source(self, u_old, p) -> bool:
-        """Assemble l by sparse maps when phi_old = source(eps(u_old), zeta_old, p) is constant on
-        every cell (variant A, lam_D = 0, P1 u; cellwise_source.py), if it gives the assembled l
-        to round-off; not with -<prefix>vi_fast 0 (today's path). Returns whether it is used."""
-        from damage_dolfinx.numerics.cellwise_source import CHECK_RTOL, CellwiseSource
-        if self.fast is None or p.variant != "A" or p.lam_D != 0.0 or \
-                compat.element_degree(u_old.function_space) != 1:
-            return False
-        # a user law (laws.py) goes through the same check: the maps compute the thesis source
-        # (1.3), accepted only if they give the assembled l of this run's own law
-        source = CellwiseSource(u_old, self.zeta_old, float(getattr(self.k, "value", self.k)), p)
-        self.cellwise_check = source.check(self.L, u_old)
-        if self.cellwise_check <= CHECK_RTOL:
-            self._cellwise = source
-        return self._cellwise is not None
 
     def _converged(self, snes, it, norms):
         """PETSc's default tests plus a step test for the VI: when many nodes sit within
@@ -169,13 +152,10 @@ class DamageStep:
             return self.linear.solve(self.zeta)
         if self.irreversible:  # the upper bound is zeta_{n-1}
             compat.petsc_vec(self.zeta_old).copy(self.upper)
-        if self._cellwise is not None:  # l by sparse maps (cellwise_source.py)
-            self._cellwise.rhs(self.b)
-        else:
-            with self.b.localForm() as bl:
-                bl.set(0.0)
-            compat.assemble_vector(self.b, self.L)
-            self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        with self.b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(self.b, self.L)
+        self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         # a source that is not finite (an overflow of phi) would be clipped to the bounds by the
         # obstacle solvers and give a finite, wrong zeta: the run fails instead, on every model
         norm = self.b.norm()  # collective: every rank decides alike

@@ -56,11 +56,8 @@ class MemoryTerm:
 
     def update(self, g_expr):
         """M_{n} from M_{n-1} and g_{n-1}: ``g_expr`` is the compiled fem.Expression of g at
-        step n-1, or a callable that writes g itself (cellwise_stress.MemoryIntegrand)."""
-        if isinstance(g_expr, fem.Expression):
-            compat.interpolate(self.g, g_expr)
-        else:
-            g_expr()
+        step n-1."""
+        compat.interpolate(self.g, g_expr)
         g, k, a = self.g.x.array, self.k, self.kernel
         self.n += 1
         if self.mode == "running":
