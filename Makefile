@@ -12,6 +12,12 @@ export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM := 1
 export OMPI_MCA_rmaps_base_oversubscribe := 1
 # the same for OpenMPI 5 (PRRTE: Debian 13 and later)
 export PRTE_MCA_rmaps_default_mapping_policy := :oversubscribe
+# Every MPI process start (mpirun's ranks, and a serial `import dolfinx`) probes the network
+# transports: under Open MPI 6 libfabric's providers (btl ofi) take about 1 s per process and
+# UCX (pml ucx) another 0.1 s. The tests and demos run on one machine: shared memory and TCP
+# (btl sm/vader, tcp, pml ob1) are what they use anyway. A value set outside is kept.
+export OMPI_MCA_btl ?= ^ofi,uct
+export OMPI_MCA_pml ?= ob1
 export OMP_NUM_THREADS := 1
 export MPLBACKEND := Agg
 

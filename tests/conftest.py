@@ -11,7 +11,11 @@ import reproduction.baselines  # noqa: F401 (registers the friction baselines in
 
 # oversubscription: OpenMPI 4 (Debian 12) reads OMPI_MCA_rmaps_base_oversubscribe, OpenMPI 5
 # (Debian 13 and later, PRRTE) PRTE_MCA_rmaps_default_mapping_policy; a 3-rank test needs it on
-# a 2-core runner
+# a 2-core runner. Transports: shared memory and TCP only (the Makefile says why: the probing
+# of libfabric and UCX costs about 1 s per process start under Open MPI 6); a value set outside
+# is kept.
+for _name, _value in (("OMPI_MCA_btl", "^ofi,uct"), ("OMPI_MCA_pml", "ob1")):
+    os.environ.setdefault(_name, _value)
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OMPI_MCA_rmaps_base_oversubscribe="1",
            PRTE_MCA_rmaps_default_mapping_policy=":oversubscribe", OMP_NUM_THREADS="1",

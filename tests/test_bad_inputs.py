@@ -109,3 +109,26 @@ def test_every_argument_of_every_entry_point_has_a_rule():
         with pytest.raises(dd.InputError, match=name):
             validation.arguments(**{name: value})
     assert validation.arguments(n=np.int64(3), T=np.float32(0.5)) == {"n": 3, "T": 0.5}
+
+
+def test_an_option_the_user_set_between_two_runs_is_kept_and_fingerprinted():
+    """A solver default replaces only its own earlier value: an option the user set since (a
+    script between two runs) stays, and the run fingerprint lists it (a restart with other
+    result-changing PETSc options is refused), while the defaults are not listed."""
+    from petsc4py import PETSc
+    from damage_dolfinx.numerics import solvers
+    from damage_dolfinx.runtime.fingerprint import given_options
+    opts = PETSc.Options()
+    try:
+        solvers.set_default_options("mech_", {"ksp_type": "cg", "ksp_rtol": 1e-12})
+        assert given_options() == []
+        opts["mech_ksp_rtol"] = "1e-3"
+        solvers.set_default_options("mech_", {"ksp_type": "cg", "ksp_rtol": 1e-12})
+        assert opts.getString("mech_ksp_rtol") == "1e-3"
+        assert given_options() == [["mech_ksp_rtol", "1e-3"]]
+        opts["mech_ksp_monitor"] = ""  # a diagnostic changes no result
+        assert given_options() == [["mech_ksp_rtol", "1e-3"]]
+    finally:
+        for name in ("mech_ksp_type", "mech_ksp_rtol", "mech_ksp_monitor"):
+            opts.delValue(name)
+            solvers._CODE_DEFAULTS.pop(name, None)

@@ -2,7 +2,8 @@
 number of ranks, the Python hash seed or how many UFL objects (constants, functions, labels,
 indices) the process made before; a changed law is named as the law, a changed constant of a
 load as the load, a zeta0(x) changed inside (same range) as zeta0, by a digest of its values at
-the nodes gathered in an order no partition changes. A restart on 1 -> 2 -> 3 ranks under different hash seeds is accepted."""
+the nodes gathered in an order no partition changes. A restart on 1 -> 2 -> 3 ranks under
+different hash seeds is accepted."""
 import json
 import subprocess
 import sys

@@ -227,3 +227,69 @@ def test_a_refused_folder_receives_no_lock_file(tmp_path):
     r = cli(*TINY, "--point", 0, "--out", out)
     assert r.returncode == 2 and "notes.txt" in r.stderr, r.stderr
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_an_interrupted_point_job_leaves_an_honest_sweep_status(tmp_path):
+    """SIGTERM to a job of one point: the point is "interrupted" and the sweep's status is
+    rebuilt at once ("incomplete": no job is live any more), not left at "running"."""
+    import signal
+    out = tmp_path / "sweep"
+    cmd = CLI + ["sweep", "2.2-ex1", "--n", "4", "--T", "50", "--k", "0.01", "--no-figures",
+                 "--quiet", "--set", "kappa=0.01,0.1", "--point", "1", "--out", str(out)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env=ENV)
+    deadline = time.monotonic() + 120
+    history = out / "point_1" / "history.csv"
+    while time.monotonic() < deadline and proc.poll() is None and \
+            not (history.exists() and history.read_text().count("\n") > 3):
+        time.sleep(0.1)  # the point's time loop is running
+    proc.send_signal(signal.SIGTERM)
+    _, stderr = proc.communicate(timeout=60)
+    assert proc.returncode == 143, stderr
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "incomplete", summary
+    assert summary["point_status"] == {"0": "pending", "1": "interrupted"}, summary
+    assert [r["status"] for r in table(out)] == ["pending", "interrupted"]
+
+
+def test_the_sweep_status_is_running_while_a_point_is_live_elsewhere(tmp_path):
+    """The aggregate rebuilt while another job's point is live (its lock held by a living
+    process) says "running" and names it; once that process is gone, "incomplete"."""
+    from damage_dolfinx.studies.sweep_folder import settle
+    out = tmp_path / "sweep"
+    args = ["sweep", "2.2-ex1", "--n", "4", "--T", "0.02", "--k", "0.01", "--no-figures",
+            "--quiet", "--set", "kappa=0.01,0.1", "--out", out]
+    assert cli(*args, "--point", 0).returncode == 0
+    mapping = json.loads((out / "points.json").read_text())
+    other = out / "point_1"
+    other.mkdir()
+    (other / "summary.json").write_text('{"status": "running"}')
+    live = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        import socket
+        (other / ".lock").write_text(f"pid {live.pid} host {socket.gethostname()} since now\n")
+        settle(out, mapping, 0, RuntimeError("a failure"), None, "2.2-ex1")
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["status"] == "running" and summary["live"] == [1], summary
+    finally:
+        live.kill()
+        live.wait()
+    settle(out, mapping, 0, RuntimeError("a failure"), None, "2.2-ex1")
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "incomplete" and summary["live"] == [], summary
+    assert summary["point_status"]["0"] == "completed"
+
+
+def test_a_mesh_size_the_geometry_refuses_is_refused_before_any_point(tmp_path):
+    out = tmp_path / "sweep"
+    r = cli("sweep", "2.1-ex1", "--n", "7", "--T", "0.02", "--set", "kappa=0.5,1",
+            "--no-figures", "--quiet", "--out", out)
+    assert r.returncode == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "point 0 (kappa = 0.5)" in lines[0] and \
+        "multiple of 5" in lines[0], r.stderr
+    assert not out.exists()
+    r = cli("sweep", "2.1-ex1", "--n", "5", "--T", "0.02", "--set", "kappa=0.5,-1",
+            "--no-figures", "--quiet", "--out", out)
+    assert r.returncode == 2 and "point 1 (kappa = -1)" in r.stderr, r.stderr
+    assert not out.exists()

@@ -56,19 +56,27 @@ def set_default_options(prefix: str, defaults: dict):
     opts = PETSc.Options()
     for name in [n for n in _CODE_DEFAULTS if n.startswith(prefix)]:
         if name[len(prefix):] not in defaults:
-            opts.delValue(name)
+            if _ours(opts, name):
+                opts.delValue(name)
             del _CODE_DEFAULTS[name]
     for key, value in defaults.items():
         name = prefix + key
-        if name in _CODE_DEFAULTS or not opts.hasName(name):
+        if _ours(opts, name) or not opts.hasName(name):
             opts[name] = value
             _CODE_DEFAULTS[name] = value
+
+
+def _ours(opts, name) -> bool:
+    """Whether the option ``name`` holds the value this module put there (a value the user set
+    since, e.g. between two runs of a script, is the user's and stays)."""
+    return name in _CODE_DEFAULTS and opts.hasName(name) and \
+        opts.getString(name, "").lower() == str(_CODE_DEFAULTS[name]).lower()
 
 
 def replace_default_option(name: str, value):
     """Change one option this module put into the database (a user's option stays)."""
     opts = PETSc.Options()
-    if name in _CODE_DEFAULTS or not opts.hasName(name):
+    if _ours(opts, name) or not opts.hasName(name):
         opts[name] = value
         _CODE_DEFAULTS[name] = value
 

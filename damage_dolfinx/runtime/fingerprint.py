@@ -38,7 +38,8 @@ from damage_dolfinx.runtime import io
 VERSION = 3
 
 #: how the items of the fingerprint are named in a refusal (in the order they are compared)
-ITEMS = {"mesh": "the mesh", "mesh_nodes": "the mesh's nodes or cells", "traction": "the traction", "body_force": "the body force",
+ITEMS = {"mesh": "the mesh", "mesh_nodes": "the mesh's nodes or cells",
+         "traction": "the traction", "body_force": "the body force",
          "damage_law": "the damage law", "zeta0": "the initial damage zeta0",
          "boundaries": "the boundary parts", "irreversible": "irreversibility",
          "reading": "the reading", "builders": "the model's own data (builders)",
@@ -54,9 +55,9 @@ def fingerprint(ex, data) -> dict:
     Problem.problem_data): the mesh
     (cells, vertices, bounding box, facet tags by count; a digest of its nodes and cells), the
     loads and the damage law by the canonical hash of the UFL they build on this mesh (their
-    literals and constants' values included: a traction 100 times larger changes it), the initial damage, the boundary parts,
-    irreversibility, the reading, the model's own data (builders) and the PETSc options given.
-    Collective on the mesh's ranks."""
+    literals and constants' values included: a traction 100 times larger changes it), the
+    initial damage, the boundary parts, irreversibility, the reading, the model's own data
+    (builders) and the PETSc options given. Collective on the mesh's ranks."""
     import ufl
     from dolfinx import fem
     from damage_dolfinx.meshes import tag_counts
@@ -190,7 +191,8 @@ def given_options() -> list:
     for name, value in PETSc.Options().getAll().items():
         if not name.startswith(PETSC_PREFIXES) or any(d in name for d in _DIAGNOSTIC):
             continue
-        if name in solvers._CODE_DEFAULTS and str(solvers._CODE_DEFAULTS[name]) == str(value):
+        if name in solvers._CODE_DEFAULTS and \
+                str(solvers._CODE_DEFAULTS[name]).lower() == str(value).lower():
             continue
         given.append([name, str(value)])
     return sorted(given)

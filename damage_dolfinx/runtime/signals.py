@@ -85,7 +85,15 @@ class StopSignals:
         self.signum, self._previous, self._first = 0, {}, None
         if threading.current_thread() is threading.main_thread():
             self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
+        _ACTIVE.append(self)
         return self
+
+    def request(self, signum):
+        """The stop ``signum`` asked for from elsewhere (another rank received it): the run
+        stops at the end of its step as if the signal had arrived here."""
+        if not self.signum:
+            self.signum, self._first = signum, time.monotonic()
+            RECEIVED["signum"] = RECEIVED["signum"] or signum
 
     def _handle(self, signum, frame):
         now = time.monotonic()
@@ -97,6 +105,8 @@ class StopSignals:
             RECEIVED["signum"] = RECEIVED["signum"] or signum
 
     def __exit__(self, *exc):
+        if self in _ACTIVE:
+            _ACTIVE.remove(self)
         for s, handler in self._previous.items():
             signal.signal(s, handler if not self.signum else self._late)
 
@@ -108,3 +118,18 @@ class StopSignals:
         for s, handler in self._previous.items():
             signal.signal(s, handler)
         os.kill(os.getpid(), signum)
+
+
+#: the StopSignals of the run in progress in this process (innermost last)
+_ACTIVE: list = []
+
+
+def forward_stop(signum):
+    """A stop signal another rank received, acted on here as if it had arrived here: the run in
+    progress stops at the end of its step (``StopSignals.request``); outside a run the
+    command stops where it is (SignalStop)."""
+    if _ACTIVE:
+        _ACTIVE[-1].request(signum)
+        return
+    RECEIVED["signum"] = RECEIVED["signum"] or signum
+    raise SignalStop(signum)

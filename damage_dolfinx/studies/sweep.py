@@ -31,11 +31,19 @@ A point whose ``summary.json`` says "completed" is kept as it is when the sweep 
 point that was interrupted reruns from its checkpoint with ``restart=True``, or from the
 start otherwise; a point live in another process is left to it.
 
+Every point is checked before any point runs, as ``run`` checks a run (its values, n, k, T
+and its mesh, built once per mesh size); a refusal names the point. The sweep's status in
+``summary.json`` is rebuilt from the points' records as each call ends, also a job of one point
+that ends early (``sweep_folder.settle``): "running" while a point is live in another process,
+else "failed", "completed" or "incomplete".
+
 Failures: a point that fails on every rank of its group (a solver, a refused value, an
 exception of user code raised alike) is recorded as failed and the sweep goes on (the
 sweep's status "failed", exit status 3 on the command line); an exception on some ranks of a
-group only, or a signal, ends the whole sweep within seconds (runtime/collective.py), with
-one line and the statuses written.
+group only ends the whole sweep within seconds (runtime/collective.py), with one line and the
+statuses written. A stop signal that reaches some ranks only is passed on to every rank
+(sweep_ranks.py): every point in progress stops at the end of its step with a checkpoint, and
+every rank ends normally with exit status 128 + signal.
 """
 from __future__ import annotations
 
@@ -50,6 +58,7 @@ from damage_dolfinx.parameters import InputError
 from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
                                                  SWEEP_FILES, plot_sweep)
 from damage_dolfinx.studies.sweep_folder import describe_values as _describe
+from damage_dolfinx.studies.sweep_ranks import StopNotice, Relay, point_outcome
 
 
 def parse_values(text: str, name: str) -> list:
@@ -149,6 +158,21 @@ def _check_layout(ranks_per_point, point, max_points, comm) -> dict:
     return {"ranks_per_point": ranks, "point": point}
 
 
+def _check_point(ex, i, values, n, k, T, meshes, together, comm):
+    """Point ``i`` checked as ``run`` checks it before any work: its description
+    (``configure``) and its mesh, built once per mesh size on ``comm`` (a size the geometry
+    refuses, such as an n the hole does not fit, is refused here, before any point runs).
+    InputError naming the point otherwise; returns the point's mesh size (n, h)."""
+    try:
+        c = ex.configure(n, k, T, None, dict(values))
+        size = (c.n, c.h)
+        if not together and size not in meshes:
+            c.make_geometry(comm, *size)
+        return size
+    except InputError as exc:
+        raise InputError(f"point {i} ({_describe(values)}): {exc}") from None
+
+
 def _shared(ex, grid) -> dict:
     """What every point shares besides n, k, T (points.json "shared"): the model, the reading
     and the parameters not swept (those a file can hold: numbers, text, flags)."""
@@ -163,12 +187,10 @@ def _shared(ex, grid) -> dict:
 def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, progress,
            ranks_per_point, point, comm) -> dict:
     from damage_dolfinx.runtime import io
-    from damage_dolfinx.runtime.collective import classify, describe, mark, track
-    from damage_dolfinx.runtime.runfolder import RunLive
+    from damage_dolfinx.runtime.collective import track
     from damage_dolfinx.runtime.runner import resolve
-    from damage_dolfinx.runtime.runner import run as run_one
     from damage_dolfinx.runtime.fingerprint import sweep_fingerprint
-    from damage_dolfinx.studies.sweep_folder import open_sweep, record
+    from damage_dolfinx.studies.sweep_folder import open_sweep, settle
 
     wall_start = time.perf_counter()
     grid = check_grid(grid)
@@ -184,8 +206,9 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     ranks = ranks_per_point or (size if together or point is not None else 1)
     ex = resolve(problem)
     checked_at = time.perf_counter()
+    meshes = set()
     for i in (range(len(points)) if point is None else [point]):  # checked before any work
-        ex.configure(n, k, T, None, dict(points[i]))
+        meshes.add(_check_point(ex, i, points[i], n, k, T, meshes, together, comm))
         if progress and comm.rank == 0 and time.perf_counter() - checked_at > 2.0:
             checked_at = time.perf_counter()
             print(f"[sweep {ex.id}] checking the grid: {i + 1}/{len(points)} points",
@@ -199,7 +222,26 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     states = open_sweep(out, mapping, point, comm)
     if point is None:  # a job of one point leaves the sweep's status to the record (others run)
         track(out, "sweep")
+    try:
+        return _run_points(problem, out, ex, points, states, mapping, n=n, k=k, T=T,
+                           restart=restart, max_points=max_points, plot=plot, figures=figures,
+                           progress=progress, ranks=ranks, point=point, comm=comm,
+                           wall_start=wall_start)
+    except BaseException as exc:
+        if point is not None and comm.rank == 0:  # interrupted or failed: an honest aggregate
+            settle(out, mapping, point, exc, plot, ex.id)
+        raise
 
+
+def _run_points(problem, out, ex, points, states, mapping, *, n, k, T, restart, max_points,
+                plot, figures, progress, ranks, point, comm, wall_start) -> dict:
+    """The points of this call (after the checks and the opening of the folder), and the
+    record."""
+    from damage_dolfinx.runtime.collective import classify, describe, mark
+    from damage_dolfinx.runtime.runfolder import RunLive
+    from damage_dolfinx.runtime.runner import run as run_one
+    from damage_dolfinx.studies.sweep_folder import record
+    size = comm.size
     if point is not None:
         pending = [] if states[point] == "completed" else [point]
         todo = pending
@@ -210,7 +252,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     group = comm if ranks == size else MPI.COMM_SELF if ranks == 1 else \
         comm.Split(color, comm.rank)
     mine = todo[color::groups]
-    relay = _Relay(comm)
+    relay, notice = Relay(comm), StopNotice(comm)
     if comm.rank == 0 and progress:
         if point is not None and not todo:
             print(f"[sweep {ex.id}] point {point} ({_describe(points[point])}) is already "
@@ -223,19 +265,21 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                 f"{size} rank(s)"
             print(f"[sweep {ex.id}] {len(points)} points, {len(points) - len(pending)} finished, "
                   f"running {len(todo)} on {layout}", flush=True)
-    failures = {}
+    failures, stopped = {}, None
     try:
         for i in mine:
+            notice.check()  # another rank stopped on a signal: this one too
             values = points[i]
             folder = out / f"point_{i}"
             resume = restart and states[i] == "checkpoint"
             start = time.perf_counter()
             try:
-                summary = _point_outcome(
+                summary = point_outcome(
                     group, comm, [(folder, "run")] + ([(out, "sweep")] if point is None else []),
                     lambda: run_one(problem, folder, n=n, k=k, T=T, overrides=dict(values),
                                     progress=False, figures=figures, restart=resume,
-                                    overwrite=not resume, comm=group))
+                                    overwrite=not resume, comm=group,
+                                    on_step=notice.check))
                 status = summary["status"]
             except RunLive:
                 if point is not None:
@@ -243,7 +287,7 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                 status = "live in another process, left to it"
             except Exception as exc:  # noqa: BLE001 - a point fails, the sweep goes on
                 if classify(exc)[2] == "interrupted":
-                    raise  # the sweep stops (collective.outcome decides for every rank)
+                    raise  # the sweep stops: every rank (below)
                 if group.rank == 0:
                     mark(folder, exc)
                 status = f"failed ({describe(exc)})"
@@ -253,9 +297,22 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
                     f"ranks {comm.rank}-{comm.rank + ranks - 1}"
                 relay.say(f"[sweep {ex.id}] point {i} ({_describe(values)}): {status} in "
                           f"{time.perf_counter() - start:.1f} s ({where})")
+    except BaseException as exc:  # noqa: BLE001 - a signal stops every rank; others raise
+        if classify(exc)[2] != "interrupted":
+            raise  # (one rank only: collective.outcome ends the others)
+        stopped = exc
+        notice.send(exc)
     finally:
         if group not in (comm, MPI.COMM_SELF):
             group.Free()
+    signum = notice.settle()  # every rank is here: stopped, or done with its points
+    if signum or stopped is not None:
+        relay.close()
+        if stopped is not None:
+            raise stopped
+        from damage_dolfinx.runtime.signals import RECEIVED, SignalStop
+        RECEIVED["signum"] = RECEIVED["signum"] or signum
+        raise SignalStop(signum)  # its points ended before the stop: stopped all the same
     failures = {i: why for part in comm.allgather(failures) for i, why in part.items()}
     relay.close()
     info = {"ran": todo, "mpi_size": size, "ranks_per_point": ranks, "groups": groups,
@@ -269,76 +326,3 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
               + (f", {len(failed)} failed" if failed else "") + " in "
               f"{summary['wall_time_s']:.1f} s; table {out / 'sweep.csv'}", flush=True)
     return summary
-
-
-def _point_outcome(group, comm, folders, body):
-    """``body()`` on every rank of ``group`` (the ranks running one point), with one outcome on
-    all of them: its value, or the same exception everywhere (a failing rank's own, the others
-    a collective.RankFailure of the same kind carrying its line). A rank that failed while its
-    partners do not join within collective.FAIL_WAIT seconds (they are blocked in a collective call it left)
-    ends the whole sweep: ``folders`` get the status, one line, MPI_Abort with its exit status
-    (collective.py's rule, here within one group while the sweep's other groups go on)."""
-    if group.size == 1:
-        return body()
-    from damage_dolfinx.runtime import collective
-    agree = group.Dup()  # before the body: a rank that fails inside it can still join
-    failure, value = None, None
-    try:
-        value = body()
-    except BaseException as exc:  # noqa: BLE001 - decided by the whole group below
-        failure = exc
-    mine = None if failure is None else \
-        (group.rank, *collective.classify(failure)[:2], collective.describe(failure))
-    request = agree.Ibarrier()
-    deadline = time.monotonic() + collective.FAIL_WAIT
-    while not request.Test():
-        if failure is not None and time.monotonic() > deadline:
-            collective._abort(comm, failure, folders)
-        time.sleep(0.002)
-    outcomes = agree.allgather(mine)
-    agree.Free()
-    failed = [o for o in outcomes if o is not None]
-    if not failed:
-        return value
-    if failure is not None:
-        raise failure
-    _, code, kind, text = failed[0]
-    raise collective.decided(text, code, kind)
-
-
-class _Relay:
-    """Progress lines of the groups' first ranks, printed by rank 0 alone (only rank 0
-    prints): rank 0 prints its own at once and the others' as they arrive, between its points
-    and at the end."""
-
-    TAG = 4242
-
-    def __init__(self, comm):
-        self.comm = comm.Dup() if comm.size > 1 else comm
-        self.sent, self.received, self.requests = 0, 0, []
-
-    def say(self, text):
-        if self.comm.rank == 0:
-            self._drain()
-            print(text, flush=True)
-        else:
-            self.requests.append(self.comm.isend(text, dest=0, tag=self.TAG))
-            self.sent += 1
-
-    def _drain(self):
-        status = MPI.Status()
-        while self.comm.size > 1 and self.comm.iprobe(source=MPI.ANY_SOURCE, tag=self.TAG,
-                                                      status=status):
-            print(self.comm.recv(source=status.Get_source(), tag=self.TAG), flush=True)
-            self.received += 1
-
-    def close(self):
-        """Collective: every line sent is printed before the summary line."""
-        if self.comm.size == 1:
-            return
-        counts = self.comm.gather(self.sent, root=0)
-        if self.comm.rank == 0:
-            for _ in range(sum(counts) - self.received):
-                print(self.comm.recv(source=MPI.ANY_SOURCE, tag=self.TAG), flush=True)
-        MPI.Request.Waitall(self.requests)
-        self.comm.Free()

@@ -213,7 +213,9 @@ def _record(out, mapping, failures, info, plot, label) -> dict:
         io.collective(MPI.COMM_SELF, out, "sweep.png", plot_sweep, out / "sweep.png", done,
                       grid, plot, label)
     failed = sorted(int(i) for i in errors)
-    status = "failed" if failed else ("completed" if len(done) == count else "incomplete")
+    live = [r["point"] for r in rows if r["status"] == "running" and _live(out / r["folder"])]
+    status = "running" if live else "failed" if failed else \
+        ("completed" if len(done) == count else "incomplete")
     known = runfolder.read_manifest(out)
     names = {f"point_{i}" for i in range(count)} | set(SWEEP_FILES)
     if known is None or not names <= known[1]:
@@ -222,11 +224,40 @@ def _record(out, mapping, failures, info, plot, label) -> dict:
                "points": count, "completed": len(done), "failed": failed, "errors": errors,
                **({"error": f"{len(failed)} of {count} points failed"} if failed else {}),
                "pending": [r["point"] for r in rows if r["status"] != "completed"],
+               "live": live,
                "point_status": {str(r["point"]): r["status"] for r in rows},
                **info, "csv": "sweep.csv",
                "plot": "sweep.png" if plot and done else None}
     io.write_json(out / "summary.json", summary, MPI.COMM_SELF)
     return summary
+
+
+def _live(folder: Path) -> bool:
+    """A run holds ``folder``'s lock: its process (named in ``.lock``) is alive."""
+    from damage_dolfinx.runtime.runfolder import _alive
+    try:
+        with open(folder / ".lock", "rb") as f:
+            holder = f.readline().decode(errors="replace").split()
+    except OSError:
+        return False
+    return len(holder) >= 4 and holder[0] == "pid" and _alive(holder[1], holder[3])
+
+
+def settle(out, mapping, point, exc, plot, label):
+    """A job of one point that stops on an exception (a signal, a failure): the point's own
+    status first (``collective.mark``: only where the run recorded none), then the aggregate
+    rebuilt from the per-point records (``_record``), so that the sweep's summary.json does
+    not stay "running" after its last live job ended. One process (the job's rank 0); never
+    raises (the exception being handled is what the caller reports)."""
+    from damage_dolfinx.runtime import runfolder
+    from damage_dolfinx.runtime.collective import mark
+    try:
+        if not isinstance(exc, runfolder.RunLive):  # (a live run there is another job's)
+            mark(Path(out) / f"point_{point}", exc)
+        with runfolder.shared_folder_lock(out, MPI.COMM_SELF):
+            _record(Path(out), mapping, {}, {"point": point}, plot, label)
+    except Exception:  # noqa: BLE001 - a full disk, a removed folder: the line still tells
+        pass
 
 
 def plot_sweep(path, rows, grid, scalar, label):
