@@ -157,6 +157,7 @@ def test_a_point_job_into_the_folder_of_another_grid_is_refused(tmp_path):
 SCRIPT = textwrap.dedent('''
     import sys
     import ufl
+    from dolfinx import fem
     from mpi4py import MPI
     import damage_dolfinx as dd
     from damage_dolfinx.geometries.rectangle import rectangle, side
@@ -171,8 +172,12 @@ SCRIPT = textwrap.dedent('''
     def law(eps, zeta, p):
         if WHERE == "group" and p.lam_u > 5e3:  # on every rank of the point's group
             raise ValueError("no law for this rate")
-        calls["law"] += 1  # (its first call: the data's check, alike on every rank)
-        if WHERE == "rank" and MPI.COMM_WORLD.rank == 3 and calls["law"] > 1:  # one rank
+        # one rank, when a point's model is built on the live damage field (not in the checks,
+        # which build the law on symbols alike on every rank)
+        if WHERE == "rank" and MPI.COMM_WORLD.rank == 3 and isinstance(zeta, fem.Function):
+            raise ZeroDivisionError("user law fails on rank 3")
+        calls["law"] += 1  # the first call: the data's check; the second: the fingerprint
+        if WHERE == "fingerprint" and MPI.COMM_WORLD.rank == 3 and calls["law"] == 2:
             raise ZeroDivisionError("user law fails on rank 3")
         return -p.lam_u * ufl.inner(eps, eps)
 
@@ -220,6 +225,17 @@ def test_a_failure_on_one_rank_of_a_group_ends_the_whole_sweep(tmp_path):
     for folder in out.glob("point_*"):
         if (folder / "summary.json").exists():
             assert json.loads((folder / "summary.json").read_text())["status"] != "running"
+
+
+@pytest.mark.mpi
+def test_user_code_failing_on_one_rank_while_the_fingerprint_is_taken_is_refused_on_all(tmp_path):
+    """The fingerprint runs the user's functions with no collective call in between and decides
+    together: a refusal on every rank (exit 2, one line naming the rank), no abort, no folder."""
+    proc, lines, out, seconds = _script(tmp_path, "fingerprint")
+    assert seconds < 30, (seconds, proc.stderr)
+    assert proc.returncode != 0 and "MPI_ABORT" not in proc.stderr, proc.stderr
+    assert "fingerprint" in proc.stderr and "rank 3" in proc.stderr, proc.stderr
+    assert not out.exists()
 
 
 def test_a_refused_folder_receives_no_lock_file(tmp_path):

@@ -58,12 +58,24 @@ def fingerprint(ex, data) -> dict:
     literals and constants' values included: a traction 100 times larger changes it), the
     initial damage, the boundary parts, irreversibility, the reading, the model's own data
     (builders) and the PETSc options given. Collective on the mesh's ranks."""
-    import ufl
-    from dolfinx import fem
     from damage_dolfinx.meshes import tag_counts
     msh = data.geometry.mesh
     comm = msh.comm
     tdim, gdim = msh.topology.dim, msh.geometry.dim
+    # the user's functions first, on each rank with no collective call in between; one exchange
+    # then decides for every rank (one that raises on one rank only is refused on all alike)
+    error, user = None, {}
+    try:
+        user = _user_items(data, msh, gdim)
+    except Exception as exc:  # noqa: BLE001 - a user function: named, one line
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        error = f"{type(exc).__name__}: {first}"
+    errors = [(rank, e) for rank, e in enumerate(comm.allgather(error)) if e is not None]
+    if errors:
+        rank, text = errors[0]
+        where = f" (rank {rank})" if len(errors) < comm.size else ""
+        raise InputError(f"a load, the damage law or zeta0(x) raised while the run's "
+                         f"fingerprint was taken: {text}{where}")
     x_local = msh.geometry.x[:, :gdim]
     lo = np.array(x_local.min(axis=0) if len(x_local) else np.full(gdim, np.inf), dtype=float)
     hi = np.array(x_local.max(axis=0) if len(x_local) else np.full(gdim, -np.inf), dtype=float)
@@ -75,22 +87,12 @@ def fingerprint(ex, data) -> dict:
                    f"{np.round(lo, 9).tolist()}-{np.round(hi, 9).tolist()}, tags "
                    f"{sorted(tag_counts(data.geometry).items())}",
            "mesh_nodes": mesh_digest(msh)}
-    x = ufl.SpatialCoordinate(msh)
-    t = fem.Constant(msh, 0.0)
-    for name in ("traction", "body_force"):
-        fn = getattr(data, name)
-        out[name] = None if fn is None else ufl_hash(fn(x, t))
-    law = data.damage_law or _thesis_law(data.params)
-    e, z = ufl.sym(ufl.outer(x, x)), x[0] * 0 + t + 1.0
-    out["damage_law"] = f"{getattr(law, 'name', '?')} {ufl_hash(law(e, z, data.params))}"
-    z0 = data.zeta0
-    if callable(z0):  # its values at the nodes, in an order no partition changes
-        pts = np.ascontiguousarray(msh.geometry.x.T)
-        values = np.asarray(z0(pts[:gdim] if gdim < 3 else pts), dtype=float).reshape(-1)
+    out.update({key: user[key] for key in ("traction", "body_force", "damage_law")})
+    if "zeta0_values" in user:  # its values at the nodes, in an order no partition changes
         out["zeta0"] = "function of x, nodal digest " + nodal_digest(
-            comm, msh.geometry.x[:, :gdim], values)
+            comm, msh.geometry.x[:, :gdim], user["zeta0_values"])
     else:
-        out["zeta0"] = float(z0)
+        out["zeta0"] = user["zeta0"]
     out["boundaries"] = repr(sorted((str(k), _tags(v))
                                     for k, v in (ex.boundaries or {}).items()))
     out["irreversible"] = bool(data.irreversible)
@@ -99,6 +101,30 @@ def fingerprint(ex, data) -> dict:
                                   for k, v in (data.builders or {}).items()))
     out["options"] = given_options()
     return json.loads(io.strict_json(out))
+
+
+def _user_items(data, msh, gdim) -> dict:
+    """The fingerprint's items that run the user's functions (the loads and the damage law by
+    the hash of the UFL they build, zeta0(x) at this rank's nodes): local, no collective call."""
+    import ufl
+    from dolfinx import fem
+    x = ufl.SpatialCoordinate(msh)
+    t = fem.Constant(msh, 0.0)
+    items = {}
+    for name in ("traction", "body_force"):
+        fn = getattr(data, name)
+        items[name] = None if fn is None else ufl_hash(fn(x, t))
+    law = data.damage_law or _thesis_law(data.params)
+    e, z = ufl.sym(ufl.outer(x, x)), x[0] * 0 + t + 1.0
+    items["damage_law"] = f"{getattr(law, 'name', '?')} {ufl_hash(law(e, z, data.params))}"
+    z0 = data.zeta0
+    if callable(z0):
+        pts = np.ascontiguousarray(msh.geometry.x.T)
+        items["zeta0_values"] = np.asarray(z0(pts[:gdim] if gdim < 3 else pts),
+                                           dtype=float).reshape(-1)
+    else:
+        items["zeta0"] = float(z0)
+    return items
 
 
 def first_difference(saved, now):
