@@ -82,8 +82,10 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
             options=(), tag: str = "") -> dict:
     k, args, _, columns = EXAMPLES[example]
     run = folder / run_name(example, n, ranks, mode, tag)
-    cmd = ["/usr/bin/time", "-f", "peak_rss_kb=%M", sys.executable, "-m", "damage_dolfinx.cli",
-           "run", example, "--n", str(n), "--k", f"{k:g}", "--T", f"{k * steps:.12g}", *args,
+    # the peak memory per rank from GNU time where it is installed (an empty list otherwise)
+    timer = ["/usr/bin/time", "-f", "peak_rss_kb=%M"] if os.path.exists("/usr/bin/time") else []
+    cmd = [*timer, sys.executable, "-m", "damage_dolfinx.cli", "run", example, "--n", str(n),
+           "--k", f"{k:g}", "--T", f"{k * steps:.12g}", *args,
            "--no-figures", "--quiet", "--write-every", str(10 ** 6), "--checkpoint-seconds",
            "0", "--overwrite", "--out", str(run), *mode_options(example, mode), *options]
     if ranks > 1:
@@ -105,8 +107,8 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
     return {"example": example, "n": n, "ranks": ranks, "mode": mode, "tag": tag,
             "options": list(options), "k": k, "steps": steps,
             "dofs_u": mesh["dofs_u"], "dofs_zeta": mesh["dofs_zeta"],
-            "command": (f"mpirun -n {ranks} " if ranks > 1 else "") + " ".join(cmd[cmd.index(
-                "-f") + 2:]),
+            "command": (f"mpirun -n {ranks} " if ranks > 1 else "") + " ".join(
+                cmd[cmd.index(sys.executable):]),
             "step_times_s": times, "step_s": float(np.mean(later)),
             "step_median_s": float(np.median(later)),
             "step_min_s": float(np.min(later)), "start_s": times[0], "first_step_s": times[1],
