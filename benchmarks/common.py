@@ -24,9 +24,12 @@ THESIS_TABLES = BENCHMARKS / "thesis_tables.json"
 
 
 def commit() -> str:
-    """Short hash of the checkout's HEAD ('unknown' outside git)."""
-    out = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
-                         capture_output=True, text=True)
+    """Short hash of the checkout's HEAD ('unknown' outside git, or where git is not installed)."""
+    try:
+        out = subprocess.run(["git", "-C", str(REPO), "rev-parse", "--short", "HEAD"],
+                             capture_output=True, text=True)
+    except OSError:
+        return "unknown"
     return out.stdout.strip() or "unknown"
 
 
