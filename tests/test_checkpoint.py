@@ -33,6 +33,14 @@ def _killed_two_rank_run(out, min_step=40):
             time.sleep(0.02)
     finally:
         proc.wait()
+        # ranks that Open MPI started outside mpirun's session (Open MPI 6's daemons) may outlive
+        # it for a moment and still write a checkpoint: kill them by their run folder, and wait
+        # until none is left before the checkpoint on disk is read
+        subprocess.run(["pkill", "-KILL", "-f", str(out)], check=False)
+        gone = time.time() + 30
+        while time.time() < gone and subprocess.run(["pgrep", "-f", str(out)],
+                                                     capture_output=True).returncode == 0:
+            time.sleep(0.05)
     assert proc.returncode != 0, "the run finished before it could be killed"
     return json.loads(meta.read_text())["step"]
 
