@@ -936,9 +936,12 @@ def main():
     parser.add_argument("--start", type=int, default=0,
                         help="skip the first START cases (e.g. 93: only the API, sweep, "
                              "converge, restart and MPI cases)")
+    parser.add_argument("--stop", type=int, default=None,
+                        help="run the cases up to row STOP (with --start: a chunk of rows, "
+                             "merged into the table as last recorded)")
     args = parser.parse_args()
     TIMEOUT[0] = args.timeout
-    cases = [c for c in CASES[args.start:]
+    cases = [c for c in CASES[args.start:args.stop]
              if not args.only or any(s in c["id"] for s in args.only)]
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
@@ -949,7 +952,7 @@ def main():
             print(f"{r['outcome']:>10s} ({r['expected']}) exit {r['exit_status']} "
                   f"{r['id']}: {r['message'][:110]}", flush=True)
             results.append(r)
-    if args.start or args.only:  # the other rows as last recorded
+    if args.start or args.stop is not None or args.only:  # the other rows as last recorded
         results = merged(results, Path(args.out) / "bad_inputs.json")
     counts, passed = write_tables(results, Path(args.out))
     kinds = {}
