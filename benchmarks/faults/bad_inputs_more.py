@@ -388,6 +388,31 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
         "run(problem(boundaries={'clamped': np.int32(1), 'traction': np.int64(2), "
         "'bilateral': np.uint8(3)}))", expect="ok", fast=False)
 
+    # ------------------------------------------------------------ 11. sweep plots, dd.steps
+    api("sweep(plot='bogus'): refused before any run", "sweep",
+        "dd.sweep(problem(), 'o', {'kappa': [1.0, 2.0]}, plot='bogus', progress=False)")
+    api("sweep(plot='contact_normal_force') of a problem with a bilateral part", "sweep",
+        "dd.sweep(problem(), 'o', {'kappa': [1.0, 2.0]}, plot='contact_normal_force', "
+        "progress=False)", expect="ok", fast=False,
+        verify=lambda w: None if (w / OUT / "sweep.png").is_file() else "no sweep.png")
+    failed_line = ("except RuntimeError as exc:\n    s = json.load(open('o/summary.json'))\n"
+                   "    print(f'damage-dolfinx: failed: {exc} (summary: {s[\"status\"]})', "
+                   "file=sys.stderr)\n    sys.exit(3 if s['status'] == 'failed' else 1)")
+    with_body = ("with dd.steps(problem(T=0.04), 'o', figures=False, progress=False) as r:\n"
+                 "    for step in r:\n        if step.n == 1{rank}:\n"
+                 "            raise RuntimeError('my own check fails')\n")
+    api("steps(): the with-body raising at step 1: the summary says failed", "api",
+        "import json\ntry:\n" + "".join("    " + line + "\n" for line in
+                                       with_body.format(rank="").splitlines()) + failed_line,
+        expect="failed", fast=False)
+    api("steps(): a break in the with-body at step 2: stopped", "api",
+        "with dd.steps(problem(T=0.04), 'o', figures=False, progress=False) as r:\n"
+        "    for step in r:\n        if step.n == 2:\n            break",
+        expect="ok", fast=False, verify=summary_check("stopped", 2))
+    api("2 ranks: steps() with-body raising on rank 1 only at step 1", "mpi",
+        with_body.format(rank=" and MPI.COMM_WORLD.rank == 1"), expect="failed", fast=False,
+        ranks=2)
+
 
 if __name__ == "__main__":
     # these cases run through bad_inputs.py (its harness, folders and table); this entry point
