@@ -27,7 +27,8 @@ def create_simplex_mesh(comm, cells, x):
     """P1 triangle (``cells`` with 3 columns, ``x`` with 2) or tetrahedron (4 columns, 3) mesh
     from this rank's cells (int64 global vertex numbers) and this rank's block of vertex
     coordinates ``x`` (rank r's rows are the vertices offset_r, offset_r + 1, ..., offsets in
-    rank order), partitioned and ghosted (shared facets) like ``create_rectangle``/``create_box``."""
+    rank order), partitioned and ghosted (shared facets) like ``create_rectangle`` and
+    ``create_box``."""
     mode = dmesh.GhostMode.shared_facet
     cells = np.asarray(cells, dtype=np.int64)
     nv = cells.shape[1]
