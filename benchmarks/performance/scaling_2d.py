@@ -314,14 +314,16 @@ def write_readme(readme: Path, block: list) -> bool:
 def solver_pairs(rows) -> dict:
     """(example, ranks, n) -> {"direct": row, "amg": row}: the ``direct`` run, else the rule's
     (``auto``) run where the rule factorises (below AMG_MIN_DOFS[2] unknowns), and the ``amg``
-    run."""
+    run, both of the same number of steps (a pair of different lengths is left out)."""
     from damage_dolfinx.numerics.scalable import AMG_MIN_DOFS
     pairs = {}
     for r in sorted(rows, key=lambda r: r["mode"] == "direct"):  # direct wins over auto
         role = "direct" if r["mode"] == "auto" and r["dofs_u"] < AMG_MIN_DOFS[2] else r["mode"]
         if role in ("direct", "amg"):
             pairs.setdefault((r["example"], r["ranks"], r["n"]), {})[role] = r
-    return pairs
+    # only runs of the same length compare (the same final time, the same timed steps)
+    return {key: both for key, both in pairs.items()
+            if len({r["steps"] for r in both.values()}) == 1}
 
 
 def crossover_table(rows) -> list:
