@@ -69,3 +69,24 @@ def serial_and_two_ranks(tmp_path, args, fields=("u", "zeta", "von_mises"), tol=
         print(f"{name}: serial vs 2 ranks relative difference {diff:.2e}")
         assert diff < tol, name
     return serial, parallel
+
+
+def owned_cell_keys(msh, keep=None):
+    """Each owned cell (those of the mask ``keep`` if given) as the sorted tuple of its vertex
+    coordinates (rounded to 1e-6), gathered from all ranks and sorted: the same cells give the
+    same list whatever the numbering and partition."""
+    from damage_dolfinx import compat
+    conn = compat.geometry_dofmap(msh)[:compat.num_owned_cells(msh)]
+    if keep is not None:
+        conn = conn[keep]
+    pts = np.round(msh.geometry.x[conn] * 1e6).astype(np.int64)
+    keys = [tuple(sorted(map(tuple, t))) for t in pts]
+    return sorted(sum(msh.comm.allgather(keys), []))
+
+
+def python_on_two_ranks(code, timeout=300):
+    """Run the Python ``code`` under mpirun -n 2 from the tests folder; assert it succeeds."""
+    proc = subprocess.run(["mpirun", "-n", "2", sys.executable, "-c", code], env=ENV,
+                          cwd=os.path.dirname(os.path.abspath(__file__)), capture_output=True,
+                          text=True, timeout=timeout)
+    assert proc.returncode == 0, proc.stdout + proc.stderr

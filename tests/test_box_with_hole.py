@@ -1,27 +1,14 @@
 """geometries/box_with_hole.py builds the box minus the hole directly (scaling): the
 same tetrahedra as DOLFINx's create_box without the cells inside the hole, the expected facet
 tags, serially and on 2 ranks. Small meshes: about a second."""
-import subprocess
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 from mpi4py import MPI
 
+from conftest import owned_cell_keys, python_on_two_ranks
 from damage_dolfinx import compat
 from damage_dolfinx.geometries import GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.box_with_hole import box_with_hole
-
-
-def cell_keys(msh):
-    """Each owned cell as the sorted tuple of its vertex coordinates (rounded), gathered."""
-    dm = msh.geometry.dofmap
-    conn = (dm.array.reshape(-1, 4) if hasattr(dm, "array") else np.asarray(dm))
-    conn = conn[:compat.num_owned_cells(msh)]
-    pts = np.round(msh.geometry.x[conn] * 1e6).astype(np.int64)
-    keys = [tuple(sorted(map(tuple, t))) for t in pts]
-    return sorted(sum(msh.comm.allgather(keys), []))
 
 
 def box_cells_outside(comm, n, side, height, nz, hole, hole_z):
@@ -31,12 +18,7 @@ def box_cells_outside(comm, n, side, height, nz, hole, hole_z):
     zlo, zhi = hole_z if hole_z is not None else (-np.inf, np.inf)
     inside = ((mid[:, 0] > hole[0]) & (mid[:, 0] < hole[1]) & (mid[:, 1] > hole[0])
               & (mid[:, 1] < hole[1]) & (mid[:, 2] > zlo) & (mid[:, 2] < zhi))
-    dm = full.geometry.dofmap
-    conn = (dm.array.reshape(-1, 4) if hasattr(dm, "array") else np.asarray(dm))
-    conn = conn[:compat.num_owned_cells(full)][~inside]
-    pts = np.round(full.geometry.x[conn] * 1e6).astype(np.int64)
-    keys = [tuple(sorted(map(tuple, t))) for t in pts]
-    return sorted(sum(comm.allgather(keys), []))
+    return owned_cell_keys(full, ~inside)
 
 
 CASES = {"cavity n=5": dict(n=5), "cavity n=10": dict(n=10),
@@ -52,7 +34,7 @@ def test_same_cells_as_create_box_minus_hole(case):
     n, height = args["n"], args.get("height", 5.0)
     nz = args.get("nz", n)
     want = box_cells_outside(comm, n, 5.0, height, nz, (2.0, 3.0), args.get("hole_z", (2.0, 3.0)))
-    got = cell_keys(g.mesh)
+    got = owned_cell_keys(g.mesh)
     assert len(got) == len(set(got)) == len(want) and got == want
     # every vertex is used by a cell (none inside the hole left over)
     n_vertices = g.mesh.topology.index_map(0).size_global
@@ -76,10 +58,5 @@ def test_same_cells_as_create_box_minus_hole(case):
 @pytest.mark.mpi
 def test_same_cells_on_two_ranks():
     """Each rank builds a slab of layers; the partitioned mesh has the same cells."""
-    from conftest import ENV
-    code = ("from test_box_with_hole import *\n"
-            "for case in CASES: test_same_cells_as_create_box_minus_hole(case)\n")
-    proc = subprocess.run(["mpirun", "-n", "2", sys.executable, "-c", code], env=ENV,
-                          cwd=str(Path(__file__).parent), capture_output=True, text=True,
-                          timeout=300)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    python_on_two_ranks("from test_box_with_hole import *\n"
+                        "for case in CASES: test_same_cells_as_create_box_minus_hole(case)\n")

@@ -67,12 +67,19 @@ def locate_entities(msh, dim, marker):
     return dmesh.locate_entities(msh, dim, marker)
 
 
+def geometry_dofmap(msh):
+    """(n_local_cells, nodes per cell) geometry node indices of all local cells (owned, then
+    ghosts) into ``msh.geometry.x``: 0.5's AdjacencyList, 0.6-0.9's array, 0.10+'s first of
+    the per-cell-type ``dofmaps``."""
+    dms = getattr(msh.geometry, "dofmaps", None)
+    dm = (dms(0) if callable(dms) else dms[0]) if dms is not None else msh.geometry.dofmap
+    return dm.array.reshape(-1, dm.links(0).size) if hasattr(dm, "array") else np.asarray(dm)
+
+
 def cell_diameters(msh, cells):
     """Largest vertex distance of the given local cells (NumPy; 0.5.2's ``cpp.mesh.h`` refuses
     the Python Mesh)."""
-    g = msh.geometry.dofmap
-    arr = g.array.reshape(-1, g.links(0).size) if hasattr(g, "array") else np.asarray(g)
-    xs = msh.geometry.x[arr[np.asarray(cells, dtype=np.int64)]]
+    xs = msh.geometry.x[geometry_dofmap(msh)[np.asarray(cells, dtype=np.int64)]]
     d = xs[:, :, None, :] - xs[:, None, :, :]
     return np.sqrt((d ** 2).sum(axis=-1)).max(axis=(1, 2))
 
@@ -97,11 +104,7 @@ def num_owned_cells(msh) -> int:
 
 def cell_vertex_coords(msh):
     """(n_owned_cells, nverts, 2) coordinates of the owned cells' geometry nodes (P1 meshes)."""
-    nc = num_owned_cells(msh)
-    dms = getattr(msh.geometry, "dofmaps", None)  # 0.10+: one dofmap per cell type
-    dm = (dms(0) if callable(dms) else dms[0]) if dms is not None else msh.geometry.dofmap
-    conn = dm.array.reshape(-1, dm.links(0).size)[:nc] if hasattr(dm, "array") else dm[:nc]
-    return msh.geometry.x[conn][:, :, :2]
+    return msh.geometry.x[geometry_dofmap(msh)[:num_owned_cells(msh)]][:, :, :2]
 
 
 def cell_dofs(V):
