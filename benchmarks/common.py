@@ -87,3 +87,13 @@ def rel(a, b) -> float:
     """Relative l2 difference of a from b."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     return float(np.linalg.norm(a - b) / max(np.linalg.norm(b), 1e-300))
+
+
+def md_head(head) -> list:
+    """A Markdown table's header and rule lines for the column names ``head``."""
+    return [md_row(head), "|" + "---|" * len(head)]
+
+
+def md_row(cells) -> str:
+    """One Markdown table row of ``cells`` (each written with str)."""
+    return "| " + " | ".join(str(c) for c in cells) + " |"

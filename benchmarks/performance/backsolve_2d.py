@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import REPO, commit  # noqa: E402
+from common import REPO, commit, md_head, md_row  # noqa: E402
 
 _PETSC = {"ksp_type": "preonly", "pc_type": "cholesky", "pc_factor_mat_solver_type": "petsc"}
 _MUMPS = {"ksp_type": "preonly", "pc_type": "cholesky", "pc_factor_mat_solver_type": "mumps"}
@@ -142,7 +142,7 @@ def report(out: Path, record: Path):
             "solve per entry [ns]", "factorise [s]", "exponent: solve / entries / factorise",
             "max rel. diff."]
     lines = [f"<!-- {time.strftime('%Y-%m-%d')}, commit {commit()}; backsolve_2d.py report -->",
-             "", "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+             "", *md_head(head)]
     for (example, ranks, config), points in sorted(series.items()):
         dofs = [d for d, _ in points]
         solve = [r["solve_s"] for _, r in points]
@@ -156,7 +156,7 @@ def report(out: Path, record: Path):
                  f"**{fit(dofs, solve):.2f}** / {fit(dofs, entries):.2f} / "
                  f"{fit(dofs, setup):.2f}",
                  f"{max(r['rel_diff_to_first'] for _, r in points):.0e}"]
-        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+        lines.append(md_row(cells))
     record.mkdir(parents=True, exist_ok=True)
     (record / "backsolve.md").write_text("\n".join(lines) + "\n")
     (record / "backsolve.json").write_text(json.dumps(runs, indent=1))

@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import REPO, commit, sorted_fields  # noqa: E402
+from common import REPO, commit, md_head, md_row, sorted_fields  # noqa: E402
 
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
@@ -198,7 +198,7 @@ def scaling_table(rows, mode="auto") -> list:
                 "mean [s]", "step 0 (factorises) / step 1 [s]", "factorisations",
                 *columns.values(), "peak RSS/rank [MB]", "process [s]"]
         lines += [f"**{example}** (k = {sel[0]['k']:g}, {sel[0]['steps']} steps, {mode})", "",
-                  "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+                  *md_head(head)]
         for r in sel:
             later = timed(r)
             cells = [r["ranks"], r["n"], _dofs(r["dofs_u"]), _dofs(r["dofs_u"] + r["dofs_zeta"]),
@@ -207,7 +207,7 @@ def scaling_table(rows, mode="auto") -> list:
                      _factorisations(r), *(its_text(r["its"][c]) for c in columns),
                      f"{max(r['peak_rss_mb_per_rank'] or [float('nan')]):.0f}",
                      f"{r['process_s']:.0f}"]
-            lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+            lines.append(md_row(cells))
         lines.append("")
     return lines + exponent_table(rows, mode)
 
@@ -218,7 +218,7 @@ def exponent_table(rows, mode="auto") -> list:
     local slopes of the median between neighbouring sizes."""
     head = ["example", "ranks", "sizes", "dofs u", "exponent (median)", "exponent (mean)",
             "local slopes (median), small to large"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = [*md_head(head)]
     for example in EXAMPLES:
         sel = [r for r in rows if r["example"] == example and r["mode"] == mode]
         for ranks in sorted({r["ranks"] for r in sel}):
@@ -229,7 +229,7 @@ def exponent_table(rows, mode="auto") -> list:
             slopes = ", ".join(f"{s:.2f}" for s in local_slopes(part))
             cells = [example, ranks, len(span), f"{min(span):.3g} - {max(span):.3g}",
                      f"**{fit(part):.2f}**", f"{fit(part, 'step_s'):.2f}", slopes]
-            lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+            lines.append(md_row(cells))
     return lines + [""]
 
 
@@ -239,7 +239,7 @@ def efficiency_table(rows, mode="auto") -> list:
     head = ["example", "n", "dofs u", "serial: time/step [s] median (min-max)",
             "2 ranks: time/step [s] median (min-max)", "speed-up 1 -> 2 ranks",
             "parallel efficiency", "step 0 + step 1 [s] serial / 2 ranks"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = [*md_head(head)]
 
     def cell(r):
         if r is None:
@@ -259,7 +259,7 @@ def efficiency_table(rows, mode="auto") -> list:
             cells = [example, n, _dofs(ref["dofs_u"]), cell(one), cell(two),
                      "-" if speed is None else f"{speed:.2f}",
                      "-" if speed is None else f"{speed / 2:.2f}", setup]
-            lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+            lines.append(md_row(cells))
     return lines + [""]
 
 
@@ -332,7 +332,7 @@ def crossover_table(rows) -> list:
     head = ["example", "ranks", "n", "dofs u", "direct: first step / later [s]",
             "AMG: first step / later [s]", "later steps direct / AMG",
             f"{RUN_STEPS}-step cost direct / AMG [s]", "faster"]
-    lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines += [*md_head(head)]
     for key in sorted(pairs):
         both = pairs[key]
         if len(both) < 2:
@@ -344,7 +344,7 @@ def crossover_table(rows) -> list:
                  f"{d['step_s'] / a['step_s']:.2f}",
                  f"{d['run100_s']:.3g} / {a['run100_s']:.3g}",
                  "AMG" if a["run100_s"] < d["run100_s"] else "direct"]
-        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+        lines.append(md_row(cells))
     return lines
 
 
@@ -353,7 +353,7 @@ def difference(rows) -> list:
     pairs = solver_pairs(rows)
     head = ["example", "ranks", "n", "dofs u", "t", "u: rel. diff. max / l2",
             "zeta: rel. diff. max / l2"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = [*md_head(head)]
     out = []
     for key in sorted(pairs):
         both = pairs[key]
@@ -370,7 +370,7 @@ def difference(rows) -> list:
             dmax = np.abs(x - y).max() / np.abs(x).max()
             dl2 = np.linalg.norm(x - y) / np.linalg.norm(x)
             cells.append(f"{dmax:.1e} / {dl2:.1e}")
-        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+        lines.append(md_row(cells))
         out.append(cells)
     return lines
 
@@ -397,7 +397,7 @@ def variants_table(rows) -> list:
     head = ["example", "ranks", "n", "dofs u", "variant (options)",
             "time/step median [s] base / variant", "ratio", "first step [s] base / variant",
             "CG its base / variant", "u, zeta: rel. diff. max"]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = [*md_head(head)]
     for r in rows:
         b = base.get((r["example"], r["n"], r["ranks"], r["mode"]))
         if not r["tag"] or b is None:
@@ -411,7 +411,7 @@ def variants_table(rows) -> list:
                  f"{b['first_step_s']:.3g} / {r['first_step_s']:.3g}",
                  f"{its_text(b['its'][col])} / {its_text(r['its'][col])}",
                  ", ".join(f"{v[0]:.1e}" for v in diff.values()) or "-"]
-        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+        lines.append(md_row(cells))
     return lines
 
 

@@ -35,6 +35,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from common import md_head, md_row  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[2]
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
            OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
@@ -126,7 +129,7 @@ def table(kind: str, rows) -> str:
              "first step [s]"]
             + list(columns.values())
             + ["peak RSS/rank [MB]", "set-up [s]", "process wall / CPU [s]"])
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = [*md_head(head)]
     for r in rows:
         cells = [r["ranks"], r["n"], f"{r['dofs_u']:,}".replace(",", " "),
                  f"{r['dofs_u'] + r['dofs_zeta']:,}".replace(",", " "),
@@ -135,7 +138,7 @@ def table(kind: str, rows) -> str:
         cells += [f"{max(r['peak_rss_mb_per_rank'] or [float('nan')]):.0f}",
                   f"{r['setup_s']:.3g}",
                   f"{r['process_s']:.3g} / {r.get('process_cpu_s', float('nan')):.3g}"]
-        lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+        lines.append(md_row(cells))
     lines.append("")
     for ranks in sorted({r["ranks"] for r in rows}):
         sel = [r for r in rows if r["ranks"] == ranks]
