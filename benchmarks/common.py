@@ -97,3 +97,36 @@ def md_head(head) -> list:
 def md_row(cells) -> str:
     """One Markdown table row of ``cells`` (each written with str)."""
     return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+#: the environment of a benchmark's runs (mpirun as root and oversubscribed, one thread a rank)
+RUN_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
+
+
+def timed_run(args, run, ranks=1) -> dict:
+    """``python -m damage_dolfinx.cli run ARGS`` from the checkout (ARGS ending in ``--out run``
+    or naming it), under ``mpirun -n ranks`` when ranks > 1, each rank under GNU time where
+    /usr/bin/time is installed; raises with the output when it fails. Returns ``cmd`` (the
+    command list), ``process_s`` (its wall time), ``summary`` (the run's summary.json),
+    ``rows`` (its history.csv rows), ``rss_mb`` (peak memory per rank, empty without GNU time)
+    and ``cpu_s`` (CPU time of all ranks, nan without GNU time)."""
+    import csv
+    import re
+    timer = (["/usr/bin/time", "-f", "peak_rss_kb=%M cpu_s=%U+%S"]
+             if os.path.exists("/usr/bin/time") else [])
+    cmd = [*timer, sys.executable, "-m", "damage_dolfinx.cli", "run", *args]
+    if ranks > 1:
+        cmd = ["mpirun", "-n", str(ranks)] + cmd
+    start = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=REPO, env=RUN_ENV, capture_output=True, text=True)
+    process_s = time.perf_counter() - start
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stdout}\n{proc.stderr}")
+    with open(Path(run) / "history.csv") as f:
+        rows = list(csv.DictReader(f))
+    cpu = re.findall(r"cpu_s=([\d.]+)\+([\d.]+)", proc.stderr)
+    return {"cmd": cmd, "process_s": process_s,
+            "summary": json.loads((Path(run) / "summary.json").read_text()), "rows": rows,
+            "rss_mb": [int(v) / 1024.0 for v in re.findall(r"peak_rss_kb=(\d+)", proc.stderr)],
+            "cpu_s": sum(float(u) + float(s) for u, s in cpu) if timer else float("nan")}

@@ -37,11 +37,8 @@ the records; ``--readme ''`` leaves it alone).
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
-import re
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -49,10 +46,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import REPO, commit, md_head, md_row, sorted_fields  # noqa: E402
+from common import REPO, commit, md_head, md_row, sorted_fields, timed_run  # noqa: E402
 
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
 #: example -> (time step, run arguments, PETSc prefixes whose rule the mode sets, history
 #: columns of iterations -> label)
 EXAMPLES = {
@@ -95,28 +90,16 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
             options=(), tag: str = "") -> dict:
     k, args, _, columns = EXAMPLES[example]
     run = folder / run_name(example, n, ranks, mode, tag)
-    # the peak memory per rank from GNU time where it is installed (an empty list otherwise)
-    timer = ["/usr/bin/time", "-f", "peak_rss_kb=%M"] if os.path.exists("/usr/bin/time") else []
-    cmd = [*timer, sys.executable, "-m", "damage_dolfinx.cli", "run", example, "--n", str(n),
-           "--k", f"{k:g}", "--T", f"{k * steps:.12g}", *args,
-           "--no-figures", "--quiet", "--write-every", str(10 ** 6), "--checkpoint-seconds",
-           "0", "--overwrite", "--out", str(run), *mode_options(example, mode), *options]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks)] + cmd
-    start = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=REPO, env=ENV, capture_output=True, text=True)
-    process_s = time.perf_counter() - start
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stdout}\n{proc.stderr}")
-    summary = json.loads((run / "summary.json").read_text())
-    with open(run / "history.csv") as f:
-        rows = list(csv.DictReader(f))
+    done = timed_run([example, "--n", str(n), "--k", f"{k:g}", "--T", f"{k * steps:.12g}", *args,
+                      "--no-figures", "--quiet", "--write-every", str(10 ** 6),
+                      "--checkpoint-seconds", "0", "--overwrite", "--out", str(run),
+                      *mode_options(example, mode), *options], run, ranks)
+    cmd, summary, rows = done["cmd"], done["summary"], done["rows"]
     times = [float(r["step_time_s"]) for r in rows]  # step 0 (t = 0 state), 1, 2, ...
     first = FIRST_TIMED[example]
     later = times[first:]
     its = {c: [int(float(r[c])) for r in rows[1:] if r.get(c) not in (None, "")]
            for c in columns}
-    rss = [int(v) / 1024.0 for v in re.findall(r"peak_rss_kb=(\d+)", proc.stderr)]
     mesh = summary["mesh"]
     return {"example": example, "n": n, "ranks": ranks, "mode": mode, "tag": tag,
             "options": list(options), "k": k, "steps": steps,
@@ -128,8 +111,8 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
             "step_min_s": float(np.min(later)), "start_s": times[0], "first_step_s": times[1],
             "run100_s": times[0] + times[1] + (RUN_STEPS - 1) * float(np.mean(later)),
             "timings_s": summary.get("timings_s", {}), "iterations": summary.get("iterations"),
-            "its": its, "run_wall_s": summary["wall_time_s"], "process_s": process_s,
-            "peak_rss_mb_per_rank": rss, "folder": str(run),
+            "its": its, "run_wall_s": summary["wall_time_s"], "process_s": done["process_s"],
+            "peak_rss_mb_per_rank": done["rss_mb"], "folder": str(run),
             "load": os.getloadavg()[0], "commit": commit(),
             "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
 

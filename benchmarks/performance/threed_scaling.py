@@ -27,8 +27,6 @@ import argparse
 import csv
 import json
 import os
-import re
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -36,11 +34,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from common import md_head, md_row  # noqa: E402
+from common import md_head, md_row, timed_run  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_rmaps_base_oversubscribe="1", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
 #: kind -> (example, run arguments, history column -> table label, stem of the outputs)
 KINDS = {
     "quasistatic": ("2.1-ex1-3d", ["--k", "0.1", "--T", "0.4"],
@@ -55,27 +51,12 @@ FIT_FROM_DOFS = 1e4
 def measure(kind: str, n: int, ranks: int, folder: Path) -> dict:
     example, args, columns, _ = KINDS[kind]
     run = folder / f"run_n{n}_p{ranks}"
-    # peak memory and CPU time per rank from GNU time where it is installed (the DOLFINx 0.9
-    # and 0.11 roots and a bare machine have none: no memory column, CPU time nan)
-    timer = (["/usr/bin/time", "-f", "peak_rss_kb=%M cpu_s=%U+%S"]
-             if os.path.exists("/usr/bin/time") else [])
-    cmd = [*timer, sys.executable, "-m", "damage_dolfinx.cli", "run", example, "--n", str(n), *args, "--no-figures", "--quiet",
-           "--write-every", "1000", "--checkpoint-seconds", "0", "--overwrite", "--out", str(run)]
-    if ranks > 1:
-        cmd = ["mpirun", "-n", str(ranks)] + cmd
-    start = time.perf_counter()
-    proc = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True)
-    process_s = time.perf_counter() - start
-    if proc.returncode != 0:
-        raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stdout}\n{proc.stderr}")
-    summary = json.loads((run / "summary.json").read_text())
-    with open(run / "history.csv") as f:
-        rows = [r for r in csv.DictReader(f) if int(r["step"]) > 0]
+    done = timed_run([example, "--n", str(n), *args, "--no-figures", "--quiet",
+                      "--write-every", "1000", "--checkpoint-seconds", "0", "--overwrite",
+                      "--out", str(run)], run, ranks)
+    cmd, summary = done["cmd"], done["summary"]
+    rows = [r for r in done["rows"] if int(r["step"]) > 0]
     times = [float(r["step_time_s"]) for r in rows]
-    rss = [int(v) / 1024.0 for v in re.findall(r"peak_rss_kb=(\d+)", proc.stderr)]
-    cpu = sum(float(u) + float(s)
-              for u, s in re.findall(r"cpu_s=([\d.]+)\+([\d.]+)", proc.stderr)) \
-        if timer else float("nan")
     mesh = summary["mesh"]
     its = {c: [int(r[c]) for r in rows if r.get(c) not in (None, "")] for c in columns}
     return {"kind": kind, "example": example, "n": n, "ranks": ranks,
@@ -84,7 +65,8 @@ def measure(kind: str, n: int, ranks: int, folder: Path) -> dict:
             "step_times_s": times, "step_s": float(np.median(times[1:])),
             "first_step_s": times[0], "its": its,
             "setup_s": summary["wall_time_s"] - sum(times), "run_wall_s": summary["wall_time_s"],
-            "process_s": process_s, "process_cpu_s": cpu, "peak_rss_mb_per_rank": rss,
+            "process_s": done["process_s"], "process_cpu_s": done["cpu_s"],
+            "peak_rss_mb_per_rank": done["rss_mb"],
             "load": os.getloadavg()[0], "date": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime())}
 
 
