@@ -9,6 +9,9 @@
   the temporary of numpy.linalg.norm (0.19 -> 0.02 ms).
 * :func:`sums_and_maxima`: sums and maxima over ranks in ONE Allreduce (an MPI operation that
   adds the first entries and takes the maximum of the others); serially no MPI call.
+* :class:`PiecewiseConstantNorm`: ||f||_L2^2 of a DG0 Function (any value shape) as w . f^2,
+  w_j = int phi_j dx assembled once: no form assembly per step (2.4 Ex. 1 at n = 128:
+  ||sigma_n||_Q 0.8 -> 0.05 ms).
 * :func:`local_dot`: x . y of the owned entries of two PETSc vectors, without the reduction of
   ``Vec.dot`` (the reductions are then gathered into one).
 """
@@ -77,3 +80,31 @@ def sums_and_maxima(comm, sums=(), maxima=()) -> tuple[list, list]:
 def local_dot(x: PETSc.Vec, y: PETSc.Vec) -> float:
     """x . y over this rank's owned entries (add over ranks to get the dot product)."""
     return float(np.dot(x.getArray(readonly=True), y.getArray(readonly=True)))
+
+
+class PiecewiseConstantNorm:
+    """||f||_L2^2 = int f : f dx of a DG0 Function f (scalar, vector or tensor values): the
+    integrand is constant on each cell, so the integral is sum_j w_j f_j^2 over the owned dofs,
+    with w_j = int phi_j dx (the cell's area or volume, one per component) assembled once. Exact
+    (the same terms as the assembled form, summed in another order). ``local()`` is this rank's
+    part (add over ranks)."""
+
+    def __init__(self, f):
+        import ufl
+        from damage_dolfinx import compat
+        Q = f.function_space
+        w = ufl.TestFunction(Q)
+        ones = ufl.as_tensor(np.ones(w.ufl_shape)) if w.ufl_shape else 1.0
+        form = compat.form(ufl.inner(ones, w) * ufl.dx)
+        vec = compat.create_vector(form)
+        with vec.localForm() as local:
+            local.set(0.0)
+        compat.assemble_vector(vec, form)
+        vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.weights = vec.getArray(readonly=True).copy()
+        vec.destroy()
+        self.f = f
+
+    def local(self) -> float:
+        values = self.f.x.array[:self.weights.size]
+        return float(np.dot(self.weights, values * values))
