@@ -64,27 +64,42 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
           checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD):
     """The run of :func:`run` (the same arguments, the same run folder), step by step::
 
-        for step in dd.steps(problem, "results/mine"):
-            R = step.contact_resultant()       # int_{Gamma_C} p nu ds, every rank
-            if R is not None and abs(R[1]) > 2.0:
-                break                          # the run stops here: status "stopped"
+        with dd.steps(problem, "results/mine") as run:
+            for step in run:
+                R = step.contact_resultant()       # int_{Gamma_C} p nu ds, every rank
+                if R is not None and abs(R[1]) > 2.0:
+                    break                          # the run stops here: status "stopped"
 
     Each ``step`` (:class:`~damage_dolfinx.runtime.runner.Step`, after the initial state and
     after every step) has ``n``, ``t``, the model and its live Functions ``u``, ``zeta``, ``v``
     (None where the scheme has none), ``contact_pressure`` (UFL, None without normal contact),
-    ``contact_resultant()`` and the ``summary`` so far. Leaving the loop stops the run at that
-    step with its outputs and a checkpoint (``restart=True`` continues it). Under MPI every
-    rank iterates and must stop at the same step (decide from collective values, as
-    ``contact_resultant()`` is). Bad input raises InputError here, before any work."""
+    ``contact_resultant()`` and the ``summary`` so far. Leaving the loop early stops the run at
+    that step with its outputs and a checkpoint (``restart=True`` continues it). Under MPI
+    every rank iterates and must stop at the same step (decide from collective values, as
+    ``contact_resultant()`` is).
+
+    An exception raised by your loop body is recorded as a failure only in the ``with`` form:
+    on leaving the ``with`` block the run is ended without any collective call, summary.json
+    says "failed" with the error, and every rank raises the same exception (a rank that raised
+    alone, under MPI, ends the job within seconds instead of leaving the others waiting). A
+    plain ``for step in dd.steps(...)`` loop works too, but Python closes the run alike after a
+    ``break`` and after an exception of the body (the run cannot tell them apart): both are
+    recorded as "stopped", and under MPI an exception on one rank only can leave the ranks
+    waiting for each other. Bad input raises InputError here, before any work."""
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.loop import Run
-    from damage_dolfinx.validation import check_run
-    checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out,
-                        comm)
-    n, k, T, restart, overwrite, checkpoint_every, progress, figures = (checked[key] for key in (
-        "n", "k", "T", "restart", "overwrite", "checkpoint_every", "progress", "figures"))
-    return Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
-                       overwrite=overwrite, checkpoint_every=checkpoint_every,
-                       progress=progress, figures=figures, comm=comm).steps()
+    from damage_dolfinx.runtime.steps import Steps
+    from damage_dolfinx.validation import check_run, communicator
+    with outcome(communicator("comm", comm)):
+        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures,
+                            out, comm)
+        n, k, T, restart, overwrite, checkpoint_every, progress, figures = (
+            checked[key] for key in ("n", "k", "T", "restart", "overwrite", "checkpoint_every",
+                                     "progress", "figures"))
+        run = Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
+                          overwrite=overwrite, checkpoint_every=checkpoint_every,
+                          progress=progress, figures=figures, comm=comm)
+    return Steps(run, comm)
 
 
 def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart=False,

@@ -44,12 +44,56 @@ def _strict(text):
     return json.loads(text, parse_constant=refuse)
 
 
-def user_files(folder, names):
-    """Files the user made (recorded as such: they must stay byte for byte)."""
+def user_files(work, where, names):
+    """Files the user made in ``work``/``where``; returns their paths relative to the case's
+    folder ``work`` (recorded as such: they must stay byte for byte)."""
+    folder = work / where
     folder.mkdir(parents=True, exist_ok=True)
     for name in names:
         (folder / name).write_bytes(f"the user's own {name}\n".encode())
-    return [str(Path(folder.name) / n) for n in names]
+    return [str(Path(where) / n) for n in names]
+
+
+def prepared(base=None, edit=None, user=(), where=OUT, write=None, links=None):
+    """The set-up of a case, ``setup(work, bases) -> the user's files`` (the one builder of
+    every case's folder): a copy of the earlier ``base`` ("run", "study", "sweep") as OUT,
+    ``edit(OUT folder)`` applied to it, the user's own files ``user`` (names) made in ``where``,
+    ``write`` = {path: bytes} files of the user's with that content and ``links`` = {path:
+    target} symbolic links (paths relative to the case's folder)."""
+    def setup(work, bases):
+        made = []
+        if base is not None:
+            shutil.copytree(bases[base], work / OUT)
+        if edit is not None:
+            edit(work / OUT)
+        if user:
+            made += user_files(work, where, user)
+        for name, content in (write or {}).items():
+            (work / name).write_bytes(content)
+            made.append(name)
+        for name, target in (links or {}).items():
+            os.symlink(work / target, work / name)
+        return made
+    return setup
+
+
+def summary_check(status=None, steps=None, points=None):
+    """verify(work): OUT's summary says ``status`` with ``steps`` steps done (and its final
+    scalars), a sweep's ``points`` points completed; None when it does, else what is wrong."""
+    def verify(work):
+        try:
+            s = json.loads((work / OUT / "summary.json").read_text())
+        except (OSError, ValueError) as exc:
+            return f"summary.json unreadable ({exc})"
+        if status is not None and s.get("status") != status:
+            return f"summary says {s.get('status')!r}, expected {status!r}"
+        if steps is not None and (s.get("steps_done") != steps or not s.get("final")):
+            return (f"summary says steps_done {s.get('steps_done')}, final "
+                    f"{'set' if s.get('final') else 'null'}; {steps} steps are on disk")
+        if points is not None and s.get("completed") != points:
+            return f"sweep summary says completed {s.get('completed')}, expected {points}"
+        return None
+    return verify
 
 
 def gmsh_mesh(path, kind):
@@ -137,43 +181,25 @@ def _inf_u(arrays, meta):
 #: (id, class, args (OUT is the folder), setup(work, bases) -> user files, expected outcome,
 #:  fast: also in tests/test_bad_inputs.py)
 def _cases():
-    def none(work, bases):
-        return []
+    none = prepared()
 
     def copy(kind):
-        def setup(work, bases):
-            shutil.copytree(bases[kind], work / OUT)
-            return []
-        return setup
+        return prepared(kind)
 
     def run_plus_user(names):
-        def setup(work, bases):
-            shutil.copytree(bases["run"], work / OUT)
-            return user_files(work / OUT, names)
-        return setup
+        return prepared("run", user=names)
 
     def study_plus_user(names):
-        def setup(work, bases):
-            shutil.copytree(bases["study"], work / OUT)
-            return user_files(work / OUT, names)
-        return setup
+        return prepared("study", user=names)
 
     def only_user(names):
-        return lambda work, bases: user_files(work / OUT, names)
+        return prepared(user=names)
 
     def checkpoint_edit(change):
-        def setup(work, bases):
-            shutil.copytree(bases["run"], work / OUT)
-            edit_checkpoint(work / OUT / "checkpoint.npz", change)
-            return []
-        return setup
+        return prepared("run", edit=lambda f: edit_checkpoint(f / "checkpoint.npz", change))
 
     def summary_text(text):
-        def setup(work, bases):
-            shutil.copytree(bases["run"], work / OUT)
-            (work / OUT / "summary.json").write_text(text)
-            return []
-        return setup
+        return prepared("run", edit=lambda f: (f / "summary.json").write_text(text))
 
     def foreign_checkpoint(work, bases):
         shutil.copytree(bases["run"], work / OUT)
@@ -187,21 +213,12 @@ def _cases():
         return setup
 
     def text_file(name, content):
-        def setup(work, bases):
-            (work / name).write_bytes(content)
-            return [name]
-        return setup
+        return prepared(write={name: content})
 
     def manifest_text(text):
-        def setup(work, bases):
-            shutil.copytree(bases["run"], work / OUT)
-            (work / OUT / "manifest.json").write_text(text)
-            return []
-        return setup
+        return prepared("run", edit=lambda f: (f / "manifest.json").write_text(text))
 
-    def out_is_file(work, bases):
-        (work / OUT).write_text("the user's file\n")
-        return [OUT]
+    out_is_file = prepared(write={OUT: b"the user's file\n"})
 
     tiny = ["--n", "5", "--k", "0.25", "--no-figures", "--quiet"]
     run = ["run", "2.1-ex1", *tiny]
@@ -561,29 +578,19 @@ def _api_cases(case, none, copy, only_user, mesh, run, conv, sweep_base):
         expect="ok", fast=False)
 
     def steps_done(n):
-        def verify(work):
-            try:
-                s = json.loads((work / OUT / "summary.json").read_text())
-            except (OSError, ValueError) as exc:
-                return f"summary.json unreadable ({exc})"
-            if s.get("status") != "completed" or s.get("steps_done") != n or not s.get("final"):
-                return (f"summary says {s.get('status')}, steps_done {s.get('steps_done')}, "
-                        f"final {'set' if s.get('final') else 'null'}; {n} steps are on disk")
-            return None
-        return verify
+        return summary_check("completed", n)
 
-    def summary_cut(work, bases):
-        shutil.copytree(bases["run"], work / OUT)
-        text = (work / OUT / "summary.json").read_text()
-        (work / OUT / "summary.json").write_text(text[:len(text) // 3])
-        return []
+    def cut_summary(folder):
+        text = (folder / "summary.json").read_text()
+        (folder / "summary.json").write_text(text[:len(text) // 3])
 
-    def summary_zero(work, bases):
-        shutil.copytree(bases["run"], work / OUT)
-        s = json.loads((work / OUT / "summary.json").read_text())
+    def zero_summary(folder):
+        s = json.loads((folder / "summary.json").read_text())
         s.update(status="failed", error="cannot write fields_final.png: No space left on device")
-        (work / OUT / "summary.json").write_text(json.dumps(s))
-        return []
+        (folder / "summary.json").write_text(json.dumps(s))
+
+    summary_cut = prepared("run", edit=cut_summary)
+    summary_zero = prepared("run", edit=zero_summary)
 
     case("completed run, summary.json cut short, --restart", "restart",
          [*run, "--restart", "--out", OUT], summary_cut, "ok", verify=steps_done(4))
@@ -667,21 +674,12 @@ def _api_cases(case, none, copy, only_user, mesh, run, conv, sweep_base):
     more.more_cases(case, api, globals(), none, copy, only_user, mesh, run, conv, sweep_base)
 
 
-def point_user_file(work, bases):
-    shutil.copytree(bases["sweep"], work / OUT)
-    shutil.rmtree(work / OUT / "point_1")
-    user_files(work / OUT / "point_1", ["notes.txt"])
-    return [f"{OUT}/point_1/notes.txt"]
-
-
-def dangling(work, bases):
-    os.symlink(work / "nowhere", work / OUT)
-    return []
-
-
-def link_loop(work, bases):
-    os.symlink(work / OUT, work / OUT)
-    return []
+#: the sweep with the user's notes in point_1/ (a folder of theirs where a point's would be)
+point_user_file = prepared("sweep", edit=lambda f: shutil.rmtree(f / "point_1"),
+                           user=["notes.txt"], where=f"{OUT}/point_1")
+#: OUT a dangling symbolic link, and a link to itself
+dangling = prepared(links={OUT: "nowhere"})
+link_loop = prepared(links={OUT: OUT})
 
 
 CASES = _cases()
@@ -936,9 +934,12 @@ def main():
     parser.add_argument("--start", type=int, default=0,
                         help="skip the first START cases (e.g. 93: only the API, sweep, "
                              "converge, restart and MPI cases)")
+    parser.add_argument("--stop", type=int, default=None,
+                        help="run the cases up to row STOP (with --start: a chunk of rows, "
+                             "merged into the table as last recorded)")
     args = parser.parse_args()
     TIMEOUT[0] = args.timeout
-    cases = [c for c in CASES[args.start:]
+    cases = [c for c in CASES[args.start:args.stop]
              if not args.only or any(s in c["id"] for s in args.only)]
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
@@ -949,7 +950,7 @@ def main():
             print(f"{r['outcome']:>10s} ({r['expected']}) exit {r['exit_status']} "
                   f"{r['id']}: {r['message'][:110]}", flush=True)
             results.append(r)
-    if args.start or args.only:  # the other rows as last recorded
+    if args.start or args.stop is not None or args.only:  # the other rows as last recorded
         results = merged(results, Path(args.out) / "bad_inputs.json")
     counts, passed = write_tables(results, Path(args.out))
     kinds = {}

@@ -1,7 +1,6 @@
 """The held-out cases of the bad-input table (rows after the API/sweep/converge/restart/MPI
 probe): other cases of each class, tried as a careful user would. Called from
 bad_inputs._api_cases with its helpers (``ns``: that module's names)."""
-import json
 import shutil
 import subprocess
 import sys
@@ -30,38 +29,14 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
     def api(id_, *args, fast=None, **kw):
         api_(id_, *args, fast=id_ in FAST, **kw)
 
-    tiny = ["--n", "5", "--k", "0.25", "--no-figures", "--quiet"]
+    prepared, summary_check = ns["prepared"], ns["summary_check"]
 
     def text_file(name, content):
-        def setup(work, bases):
-            (work / name).write_bytes(content)
-            return [name]
-        return setup
-
-    def summary_check(status=None, steps=None, kind="run", points=None):
-        """verify(work): the summary (of ``OUT``) says ``status`` with ``steps`` steps done."""
-        def verify(work):
-            try:
-                s = json.loads((work / OUT / "summary.json").read_text())
-            except (OSError, ValueError) as exc:
-                return f"summary.json unreadable ({exc})"
-            if status is not None and s.get("status") != status:
-                return f"summary says {s.get('status')!r}, expected {status!r}"
-            if steps is not None and (s.get("steps_done") != steps or not s.get("final")):
-                return (f"summary says steps_done {s.get('steps_done')}, final "
-                        f"{'set' if s.get('final') else 'null'}; {steps} steps are on disk")
-            if points is not None and s.get("completed") != points:
-                return f"sweep summary says completed {s.get('completed')}, expected {points}"
-            return None
-        return verify
+        return prepared(write={name: content})
 
     def run_edit(edit, kind="run"):
         """A copy of the base ``kind`` with ``edit(folder)`` applied."""
-        def setup(work, bases):
-            shutil.copytree(bases[kind], work / OUT)
-            edit(work / OUT)
-            return []
-        return setup
+        return prepared(kind, edit=edit)
 
     # ------------------------------------------------------------ 1. one rank fails, all end
     raise_on = ("def boom(step):\n    if MPI.COMM_WORLD.rank == {r} and step.n == {n}:\n"
@@ -99,19 +74,13 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
         "progress=False)", fast=False, ranks=2)
 
     # ------------------------------------------------------------ 2. sweep folder discipline
-    def user_in_point_subfolder(work, bases):
-        shutil.copytree(bases["sweep"], work / OUT)
-        return ns["user_files"](work / OUT / "point_0" / "mine", ["notes.txt"])
+    def no_point_1(folder):
+        shutil.rmtree(folder / "point_1")
 
-    def point_is_users_file(work, bases):
-        shutil.copytree(bases["sweep"], work / OUT)
-        shutil.rmtree(work / OUT / "point_1")
-        (work / OUT / "point_1").write_text("the user's own file\n")
-        return [f"{OUT}/point_1"]
-
-    def user_beside_sweep(work, bases):
-        shutil.copytree(bases["sweep"], work / OUT)
-        return ns["user_files"](work / OUT, ["notes.txt"])
+    user_in_point_subfolder = prepared("sweep", user=["notes.txt"], where=f"{OUT}/point_0/mine")
+    point_is_users_file = prepared("sweep", edit=no_point_1,
+                                   write={f"{OUT}/point_1": b"the user's own file\n"})
+    user_beside_sweep = prepared("sweep", user=["notes.txt"])
 
     case("sweep again, a user's file in point_0/mine/", "sweep",
          [*sweep_base, "--set", "kappa=1,2", "--out", OUT], user_in_point_subfolder)
@@ -206,11 +175,6 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
         code="dd.converge(problem(traction=lambda x, t: ufl.as_vector((99.0 * t, 0.0))), 'o', "
              "n=[2], k=[0.01], ref_n=4, ref_k=0.005, progress=False, restart=True)", fast=False)
 
-    def restart_base_plus(extra):
-        def setup(work, bases):
-            shutil.copytree(bases["run"], work / OUT)
-            return []
-        return setup
     case("--restart -mech_ksp_rtol 1e-2 (a result-changing PETSc option)", "restart",
          [*run, "--T", "2", "--restart", "--out", OUT, "-mech_ksp_type", "cg",
           "-mech_pc_type", "jacobi", "-mech_ksp_rtol", "1e-2"], copy("run"))
@@ -379,10 +343,7 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
     case("--mesh a .txt file", "mesh", ["run", "2.1-ex2a", "--mesh", "m.txt", "--out", OUT],
          text_file("m.txt", b"not a mesh\n"))
 
-    def dangling_mesh(work, bases):
-        import os
-        os.symlink(work / "nowhere.msh", work / "m.msh")
-        return []
+    dangling_mesh = prepared(links={"m.msh": "nowhere.msh"})
     case("--mesh a dangling link", "mesh", ["run", "2.1-ex2a", "--mesh", "m.msh", "--out", OUT],
          dangling_mesh)
 
@@ -419,16 +380,38 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
               "--out", OUT], expect="failed", fast=False)
 
     # ------------------------------------------------------------ 10. weak messages
-    def parent_is_file(work, bases):
-        (work / "p").write_text("the user's file\n")
-        return ["p"]
+    parent_is_file = prepared(write={"p": b"the user's file\n"})
     case("--out below a file of the user's", "folder", [*run, "--out", "p/o"], parent_is_file)
     api("T=np.float32(0.02) (a NumPy float32)", "api",
         "run(problem(T=np.float32(0.02), k=np.float32(0.01)))", expect="ok", fast=False)
     api("boundaries with NumPy tags", "api",
         "run(problem(boundaries={'clamped': np.int32(1), 'traction': np.int64(2), "
         "'bilateral': np.uint8(3)}))", expect="ok", fast=False)
-    del tiny
+
+    # ------------------------------------------------------------ 11. sweep plots, dd.steps
+    api("sweep(plot='bogus'): refused before any run", "sweep",
+        "dd.sweep(problem(), 'o', {'kappa': [1.0, 2.0]}, plot='bogus', progress=False)")
+    api("sweep(plot='contact_normal_force') of a problem with a bilateral part", "sweep",
+        "dd.sweep(problem(), 'o', {'kappa': [1.0, 2.0]}, plot='contact_normal_force', "
+        "progress=False)", expect="ok", fast=False,
+        verify=lambda w: None if (w / OUT / "sweep.png").is_file() else "no sweep.png")
+    failed_line = ("except RuntimeError as exc:\n    s = json.load(open('o/summary.json'))\n"
+                   "    print(f'damage-dolfinx: failed: {exc} (summary: {s[\"status\"]})', "
+                   "file=sys.stderr)\n    sys.exit(3 if s['status'] == 'failed' else 1)")
+    with_body = ("with dd.steps(problem(T=0.04), 'o', figures=False, progress=False) as r:\n"
+                 "    for step in r:\n        if step.n == 1{rank}:\n"
+                 "            raise RuntimeError('my own check fails')\n")
+    api("steps(): the with-body raising at step 1: the summary says failed", "api",
+        "import json\ntry:\n" + "".join("    " + line + "\n" for line in
+                                       with_body.format(rank="").splitlines()) + failed_line,
+        expect="failed", fast=False)
+    api("steps(): a break in the with-body at step 2: stopped", "api",
+        "with dd.steps(problem(T=0.04), 'o', figures=False, progress=False) as r:\n"
+        "    for step in r:\n        if step.n == 2:\n            break",
+        expect="ok", fast=False, verify=summary_check("stopped", 2))
+    api("2 ranks: steps() with-body raising on rank 1 only at step 1", "mpi",
+        with_body.format(rank=" and MPI.COMM_WORLD.rank == 1"), expect="failed", fast=False,
+        ranks=2)
 
 
 if __name__ == "__main__":

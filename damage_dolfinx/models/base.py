@@ -134,6 +134,15 @@ class Model:
         """The data as the boundary roles named by a problem select them (default: as given)."""
         return params
 
+    @classmethod
+    def declared_columns(cls, problem, dim: int) -> list:
+        """The history columns an instance built for ``problem`` (a configured Problem: its
+        ``builders``) on a mesh of dimension ``dim`` declares before the run attaches its
+        contact outputs (its ``extra_history_columns`` after the constructor), known before
+        anything is built (the sweep refuses a plot of a scalar no point reports with it).
+        A model whose columns depend on the data overrides it."""
+        return list(cls.history_columns)
+
     @property
     def extra_history_columns(self) -> list:
         return list(getattr(self, "_history_columns", None) or self.history_columns)

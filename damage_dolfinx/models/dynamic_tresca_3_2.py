@@ -133,6 +133,12 @@ class DynamicTresca(Model):
         self.k_max_lower_bound = out.get("k_max_lower_bound")
         return None if out["k_max"] is None else float(out["k_max"])
 
+    @classmethod
+    def declared_columns(cls, problem, dim: int) -> list:
+        """friction_its and u_tau_max_<face> per face of ``builders["contact_faces"]``."""
+        faces = problem.builders.get("contact_faces") or {}
+        return ["friction_its"] + [f"u_tau_max_{name}" for name in faces]
+
     # -- measured tangential displacement on named contact faces (Example 2: top vs bottom)
     def _faces_setup(self, faces: dict):
         nodes = self.friction.nodes  # owned contact nodes with their unit tangents

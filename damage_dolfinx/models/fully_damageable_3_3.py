@@ -96,6 +96,13 @@ class FullyDamageableContact(Model):
                                       "damage_active": True, "stability_check": "error",
                                       "elastic_term": "explicit"})
 
+    @classmethod
+    def declared_columns(cls, problem, dim: int) -> list:
+        """v_L2, the contact monitor's (penetration_max, penetration_x1..x<dim>) and the
+        probe's (zeta_probe, when ``builders["probe"]`` names a point)."""
+        return (["v_L2", "penetration_max"] + [f"penetration_x{i + 1}" for i in range(dim)]
+                + ([] if problem.builders.get("probe") is None else ["zeta_probe"]))
+
     def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra

@@ -102,6 +102,11 @@ class KelvinVoigtTresca(Model):
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
 
+    @classmethod
+    def declared_columns(cls, problem, dim: int) -> list:
+        """The probe's columns when ``builders["probe"]`` names a point (_probe_setup)."""
+        return [] if problem.builders.get("probe") is None else ["probe_u1", "probe_sigma_tau"]
+
     # -- a point on Gamma_C whose horizontal displacement and tangential stress are recorded
     def _probe_setup(self, point, residual_form):
         self.extra_history_columns = []

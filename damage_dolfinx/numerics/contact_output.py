@@ -122,12 +122,8 @@ class ContactOutput:
             force = near_contact(force, self.V, tags)  # only its rows on Gamma_C are read
         self._force = force if isinstance(force, tuple) else compat.form(force)
         self.slip_rate, self.eps_slip = slip_rate, eps_slip
-        size = "length" if self.dim == 2 else "area"
-        self.columns = (["contact_normal_force"] + [f"contact_force_{c}" for c in "xyz"[:bs]]
-                        + [f"contact_{size}", "contact_penetration"])
-        if slip_rate is not None:
-            self.columns += ["friction_force", f"slip_{size}"]
-        self._size = size
+        self.columns = self.names(self.dim, slip_rate is not None)
+        self._size = "length" if self.dim == 2 else "area"
         Z = compat.scalar_p1(msh)
         self.pressure = fem.Function(Z, name="contact_pressure")
         self._z_nodes = self._matching_nodes(Z, owned)
@@ -135,6 +131,15 @@ class ContactOutput:
         if slip_rate is not None:
             self.traction = fem.Function(self.V, name="friction_traction")
             self.fields.append(self.traction)
+
+    @staticmethod
+    def names(dim: int, friction: bool) -> list:
+        """The history columns of the contact outputs on a mesh of dimension ``dim``
+        (``friction``: with a slip rate, the friction force and the sliding part)."""
+        size = "length" if dim == 2 else "area"
+        return (["contact_normal_force"] + [f"contact_force_{c}" for c in "xyz"[:dim]]
+                + [f"contact_{size}", "contact_penetration"]
+                + (["friction_force", f"slip_{size}"] if friction else []))
 
     def _matching_nodes(self, Z, owned):
         """Owned dofs of the scalar P1 space Z at the contact nodes (matched by coordinates)."""

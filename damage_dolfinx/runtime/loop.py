@@ -225,7 +225,16 @@ class Run(RunRecords):
                 if stepper.n < N and self.supported:
                     self.save_checkpoint()
             while stop is None and stepper.n < N:
-                stop = yield from self._step()
+                stop, step = self._step()
+                if stop:
+                    break
+                try:  # here, not in _step: a close reaches a nested generator's caller too
+                    yield Step(self)
+                except GeneratorExit:  # the caller stopped here: the outputs of a stop
+                    if self.abandoned:
+                        raise
+                    self._outputs("stopped", *step)
+                    stop = "stopped"
             self._finish(stop)
         except (ConvergenceError, io.OutputError) as exc:
             self._failed(exc)
@@ -250,7 +259,8 @@ class Run(RunRecords):
         return stats, scalars
 
     def _step(self):
-        """One step and its outputs; yields the Step; returns the reason to stop (or None)."""
+        """One step and its outputs; returns the reason to stop (or None) and what the outputs
+        of a stop at this step need."""
         stepper, N, o = self.stepper, self.N, self.options
         start = time.perf_counter()
         stats = solver_step(stepper.advance, f"step {stepper.n + 1} (t = "
@@ -273,16 +283,7 @@ class Run(RunRecords):
         scalars, row = self._outputs(stop, step, scalars, since_checkpoint)
         self.timed_figures()
         self.report(stepper.n, stepper.t, stats, scalars, force=bool(stop))
-        if stop:
-            return stop
-        try:
-            yield Step(self)
-        except GeneratorExit:  # the caller stopped here: the outputs of a stopping step
-            if self.abandoned:
-                raise
-            self._outputs("stopped", (stats, step_time, row), scalars, None)
-            return "stopped"
-        return None
+        return stop, ((stats, step_time, row), scalars, None)
 
     def _outputs(self, stop, step, scalars, since_checkpoint):
         """The history row, fields and checkpoint a step is due (a stopping step has them

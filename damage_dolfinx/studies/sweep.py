@@ -127,7 +127,9 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     before any run. Finished points are kept when the sweep runs again; interrupted ones
     rerun, from their checkpoint with ``restart=True``. ``max_points``: run at most this many
     of the points not yet finished, then stop (the others stay pending). ``plot``: the final
-    scalar drawn against the swept parameters in ``sweep.png``. ``n``, ``k``, ``T`` apply to
+    scalar drawn against the swept parameters in ``sweep.png`` (a name that is not one of the
+    final scalars a run of the problem reports is refused before any run, for the package's
+    models; with a model of your own, after the runs: a warning, no plot). ``n``, ``k``, ``T`` apply to
     every point. ``ranks_per_point``: the size of the groups of ranks that each run one point
     in parallel (a divisor of the number of ranks; default 1). ``point``: run only this point
     (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
@@ -159,19 +161,27 @@ def _check_layout(ranks_per_point, point, max_points, comm) -> dict:
     return {"ranks_per_point": ranks, "point": point}
 
 
-def _check_point(ex, i, values, n, k, T, meshes, together, comm):
+def _check_point(ex, i, values, n, k, T, meshes, together, comm, plot=None):
     """Point ``i`` checked as ``run`` checks it before any work: its description
     (``configure``) and its mesh, built once per mesh size on ``comm`` (a size the geometry
-    refuses, such as an n the hole does not fit, is refused here, before any point runs).
-    InputError naming the point otherwise; returns the point's mesh size (n, h)."""
+    refuses, such as an n the hole does not fit, is refused here, before any point runs), and
+    (``plot``) that ``plot`` is one of the final scalars its run reports
+    (validation_scalars.py). InputError naming the point otherwise; returns the point's mesh
+    size (n, h)."""
     try:
         c = ex.configure(n, k, T, None, dict(values))
         size = (c.n, c.h)
+        geometry = None
         if not together and size not in meshes:
-            c.make_geometry(comm, *size)
-        return size
+            geometry = c.make_geometry(comm, *size)
+        if plot is not None and geometry is None:
+            geometry = c.make_geometry(comm, *size)
     except InputError as exc:
         raise InputError(f"point {i} ({_describe(values)}): {exc}") from None
+    if plot is not None:  # the first point checked: the scalars its run reports
+        from damage_dolfinx.validation_scalars import check_plot
+        check_plot(plot, c, geometry, comm)
+    return size
 
 
 def _another_sweep(out, mapping, comm):
@@ -226,7 +236,8 @@ def _sweep(problem, out, grid, *, n, k, T, restart, max_points, plot, figures, p
     checked_at = time.perf_counter()
     meshes = set()
     for i in (range(len(points)) if point is None else [point]):  # checked before any work
-        meshes.add(_check_point(ex, i, points[i], n, k, T, meshes, together, comm))
+        meshes.add(_check_point(ex, i, points[i], n, k, T, meshes, together, comm,
+                                plot if not meshes else None))
         if progress and comm.rank == 0 and time.perf_counter() - checked_at > 2.0:
             checked_at = time.perf_counter()
             print(f"[sweep {ex.id}] checking the grid: {i + 1}/{len(points)} points",

@@ -1,0 +1,70 @@
+"""The run step by step in the caller's own loop (:func:`damage_dolfinx.steps`):
+:class:`Steps` is both an iterator over the run's steps and a context manager.
+
+Why the context manager. When a plain ``for step in dd.steps(...)`` loop ends, Python closes
+the run's generator in the same way whether the loop body executed ``break`` or raised: the
+generator receives ``GeneratorExit`` with the caller's exception out of its sight (CPython
+stores the exception in flight while it finalises the generator). A raise is then recorded as
+a stop ("stopped", with the outputs of a stopping step), and under MPI a rank that raised
+alone would write those outputs collectively while the others solve the next step: it would
+wait for ever. Inside ``with dd.steps(...) as run:`` the exit sees the exception:
+
+* the body raised (on any rank): the run is abandoned without any collective call
+  (``Run.abandon``), then the call's outcome is decided on every rank
+  (runtime/collective.py: one line, the status "failed" with the error in summary.json, one
+  exception everywhere; a rank left alone aborts the job after ``FAIL_WAIT`` seconds rather
+  than wait);
+* the body left the loop early (``break``) or ended: the run stops at that step with its
+  outputs and a checkpoint (status "stopped"), or has completed.
+"""
+from __future__ import annotations
+
+
+class Steps:
+    """The steps of one prepared run (``Run.prepare``): iterate over it, or use it as a
+    context manager around the loop (see the module's docstring)."""
+
+    def __init__(self, run, comm):
+        self._run, self._comm = run, comm
+        self._steps = run.steps()
+        self._outcome = None
+
+    # -- the iterator
+    def __iter__(self):
+        return self
+
+    def __next__(self):
+        return next(self._steps)
+
+    def close(self):
+        """Stop the run at the current step (status "stopped", outputs and a checkpoint);
+        collective: every rank stops at the same step."""
+        self._steps.close()
+
+    @property
+    def summary(self):
+        """The run's summary so far (None before its set-up)."""
+        return self._run.summary
+
+    # -- the context manager
+    def __enter__(self):
+        from damage_dolfinx.runtime.collective import outcome
+        self._outcome = outcome(self._comm)
+        self._outcome.__enter__()
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        decide, self._outcome = self._outcome, None
+        if exc is not None:  # the body raised: no stopping outputs, no collective call
+            try:
+                self._run.abandon(self._steps)
+            except Exception:  # noqa: BLE001 - the body's exception is the outcome
+                pass
+            return decide.__exit__(exc_type, exc, tb)
+        try:
+            self._steps.close()  # a break: stopped here (a finished run: nothing to do)
+        except BaseException as error:  # noqa: BLE001 - decided on every rank
+            if not decide.__exit__(type(error), error, error.__traceback__):
+                raise
+            return False
+        return decide.__exit__(None, None, None)

@@ -1,0 +1,95 @@
+"""dd.steps: the run in the caller's own loop. In the ``with`` form an exception of the loop body
+is a failure (summary.json "failed" with the error, one outcome on every rank, no rank left
+waiting); a ``break`` is a stop, in either form."""
+import json
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+import damage_dolfinx as dd
+from conftest import ENV
+
+CASE = dict(n=5, k=0.25, T=1.0, progress=False, figures=False)
+
+
+def summary(out):
+    return json.loads((out / "summary.json").read_text())
+
+
+def test_a_raise_in_the_with_body_is_a_failure(tmp_path):
+    out = tmp_path / "o"
+    with pytest.raises(ZeroDivisionError):
+        with dd.steps("2.1-ex1", out, **CASE) as run:
+            for step in run:
+                if step.n == 2:
+                    1 / 0
+    s = summary(out)
+    assert s["status"] == "failed", s
+    assert s["error"].startswith("ZeroDivisionError: division by zero"), s["error"]
+
+
+def test_a_break_in_the_with_body_is_a_stop(tmp_path):
+    out = tmp_path / "o"
+    with dd.steps("2.1-ex1", out, **CASE) as run:
+        for step in run:
+            if step.n == 2:
+                break
+    s = summary(out)
+    assert (s["status"], s["steps_done"]) == ("stopped", 2), s
+    assert (out / "checkpoint.json").is_file()  # restart=True continues it
+
+
+def test_the_with_form_runs_to_the_end(tmp_path):
+    out = tmp_path / "o"
+    with dd.steps("2.1-ex1", out, **CASE) as run:
+        seen = [step.n for step in run]
+    assert seen == [0, 1, 2, 3, 4]
+    assert summary(out)["status"] == "completed" and run.summary["status"] == "completed"
+
+
+def test_a_break_in_a_plain_loop_is_a_stop(tmp_path):
+    out = tmp_path / "o"
+    for step in dd.steps("2.1-ex1", out, **CASE):
+        if step.n == 1:
+            break
+    s = summary(out)
+    assert (s["status"], s["steps_done"]) == ("stopped", 1), s
+
+
+SCRIPT = textwrap.dedent('''
+    import sys
+    from mpi4py import MPI
+    import damage_dolfinx as dd
+
+    with dd.steps("2.1-ex1", sys.argv[1], n=5, k=0.25, T=1.0, progress=False,
+                  figures=False) as run:
+        for step in run:
+            if step.n == 2 and MPI.COMM_WORLD.rank == 1:
+                raise RuntimeError("the loop body fails on rank 1")
+''')
+
+
+def test_a_raise_on_rank_1_only_in_the_with_body_ends_both_ranks(tmp_path):
+    script, out = tmp_path / "mine.py", tmp_path / "o"
+    script.write_text(SCRIPT)
+    start = time.monotonic()
+    proc = subprocess.run(["mpirun", "-n", "2", sys.executable, str(script), str(out)],
+                          capture_output=True, text=True, env=ENV, timeout=60)
+    assert time.monotonic() - start < 30, proc.stderr
+    assert proc.returncode == 3, proc.stderr
+    lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    assert len(lines) == 1 and "rank 1" in lines[0] and "RuntimeError" in lines[0], proc.stderr
+    s = summary(out)
+    assert s["status"] == "failed" and "RuntimeError" in s["error"], s
+
+
+def test_on_step_stops_the_run_after_a_few_steps(tmp_path):
+    """A stop after the first step is recorded as such (it stayed "running" when the stop was
+    caught in a generator nested in the run's own)."""
+    out = tmp_path / "o"
+    s = dd.run("2.1-ex1", out, on_step=lambda step: step.n == 2, **CASE)
+    assert (s["status"], s["steps_done"]) == ("stopped", 2)
+    assert summary(out)["status"] == "stopped"
