@@ -888,11 +888,13 @@ NOTES = [
     "it warned after the runs, the final scalars being known only once a model was built; they "
     "are now known from the model class and the problem before any work, and the plot is "
     "refused there).", "",
-    "Rows 315-319 are the two mechanisms added last: a sweep's plot checked against the final "
+    "Rows 315-320 are the two mechanisms added last: a sweep's plot checked against the final "
     "scalars before any run (an unknown one refused, a contact scalar of a problem with a "
     "contact part accepted), and `with dd.steps(...) as run:`, whose exit sees an exception of "
     "the loop body (failed, with the error; on 2 ranks a raise on rank 1 alone ends both ranks "
-    "with one line), a break being a stop.", "",
+    "with one line), a break being a stop; a plain `for step in dd.steps(...)` loop raising on "
+    "rank 1 alone ends both ranks too (the ranks agree after every step whether their loops "
+    "went on; on the code before, it had not ended after 40 s).", "",
     "Every row below is the result of the current code: the table is written again whole, in "
     "chunks (`python benchmarks/faults/bad_inputs.py --start 0 --stop 100`, then `--start 100 "
     "--stop 200`, then `--start 200`; each chunk merged into the table as last recorded).", "",
