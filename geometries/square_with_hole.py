@@ -1,8 +1,11 @@
 """Square (0, side)^2 with a centred square hole, structured (Section 2.1 Example 1).
 
-The n x n grid with diagonals 'right' is built by DOLFINx and the cells inside the hole are
-removed with ``create_submesh``; meshes with n and 2n are therefore nested. Gamma_D is the hole
-boundary, Gamma_N the outer boundary.
+The n x n grid of squares, each cut along its diagonal 'right' into the two triangles of
+DOLFINx's ``create_rectangle``, without the squares of the hole; meshes with n and 2n are
+therefore nested. The cells and vertices outside the hole are built directly, each rank a slab of
+rows, and handed to ``create_mesh``: linear in the cells (cutting the hole out of the full grid
+with DOLFINx 0.5.2's ``create_submesh`` grew like N^1.7, 340 s at 10^6 unknowns). Gamma_D is
+the hole boundary, Gamma_N the outer boundary.
 """
 import math
 
@@ -22,13 +25,8 @@ def square_with_hole(comm, n: int, side: float = 5.0, hole=(2.0, 3.0)) -> Geomet
         raise InputError(f"n = {n}: the hole [{lo}, {hi}]^2 must lie on grid lines of the "
                          f"{side} x {side} square, i.e. n must be a positive multiple of "
                          f"{int(round(side / math.gcd(int(round(side)), 1)))}")
-    full = compat.create_rectangle(comm, (0.0, 0.0), (side, side), (n, n))
     tol = 1e-10 * side
-
-    mid = compat.cell_midpoints(full)
-    outside = (mid[:, 0] < lo) | (mid[:, 0] > hi) | (mid[:, 1] < lo) | (mid[:, 1] > hi)
-    keep = np.flatnonzero(outside[:compat.num_owned_cells(full)]).astype(np.int32)
-    msh = compat.create_submesh(full, 2, keep)
+    msh = _square_minus_hole(comm, n, side, hole)
 
     def on_hole(x):
         return (x[0] >= lo - tol) & (x[0] <= hi + tol) & (x[1] >= lo - tol) & (x[1] <= hi + tol)
@@ -45,3 +43,36 @@ def square_with_hole(comm, n: int, side: float = 5.0, hole=(2.0, 3.0)) -> Geomet
     return Geometry(msh, tags, h=side * math.sqrt(2.0) / n,
                     grid=StructuredGrid(0.0, 0.0, side, side, n, n),
                     description=f"(0,{side})^2 minus [{lo},{hi}]^2, {n}x{n} grid, diagonals right")
+
+
+#: the 2 triangles of a square in DOLFINx's create_rectangle (diagonal 'right'), corners
+#: numbered dx + 2 dy
+_TRIANGLES = np.array([(0, 1, 3), (0, 2, 3)])
+
+
+def _square_minus_hole(comm, n, side, hole):
+    """The mesh of the square minus the hole: vertex (ix, iy) at (ix side/n, iy side/n),
+    numbered in create_rectangle's order (x fastest) without the vertices strictly inside the
+    hole; rank r builds the rows of squares iy in [r n/p, (r+1) n/p) and the r-th block of
+    vertex rows."""
+    m = n + 1
+    ilo, ihi = (int(round(v * n / side)) for v in hole)
+    i = np.arange(m)
+    # vertices: all but those strictly inside the hole; number[full index] = compact index
+    inner = (i > ilo) & (i < ihi)
+    used = ~(inner[:, None] & inner[None, :]).ravel()
+    number = np.cumsum(used, dtype=np.int64) - 1
+    n_used = int(number[-1]) + 1
+    r, p = comm.rank, comm.size
+    full = np.flatnonzero(used)[n_used * r // p:n_used * (r + 1) // p]
+    fy, fx = np.divmod(full, m)
+    x = np.column_stack([fx * (side / n), fy * (side / n)])
+    # this rank's squares (outside the hole) and their 2 triangles
+    hy, hx = (a.ravel() for a in np.meshgrid(np.arange(n * r // p, n * (r + 1) // p),
+                                             np.arange(n), indexing="ij"))
+    hole_cell = (hx >= ilo) & (hx < ihi) & (hy >= ilo) & (hy < ihi)
+    hx, hy = hx[~hole_cell], hy[~hole_cell]
+    v0 = hx + m * hy
+    corner = np.array([dx + m * dy for dy in (0, 1) for dx in (0, 1)])
+    cells = number[(v0[:, None] + corner[None, :])[:, _TRIANGLES].reshape(-1, 3)]
+    return compat.create_simplex_mesh(comm, cells, x)

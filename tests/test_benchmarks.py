@@ -76,7 +76,9 @@ def test_scaling_2d_report(tmp_path):
     """The 2-D scaling report from one real tiny run and rows derived from it at sizes of the
     fit (time per step = c N^1.1 serially, c N^0.9 on 2 ranks): the tables carry every row, the
     least-squares exponent and the local slopes are the ones put in, a tagged variant is
-    compared with its base run (same answers: difference 0)."""
+    compared with its base run (same answers: difference 0); the serial / 2-rank table carries
+    the speed-up and efficiency put in, and the README's scaling block (between its markers) is
+    rewritten from the records, the text around it kept."""
     import json
     script = BENCH / "performance" / "scaling_2d.py"
     out, record = tmp_path / "out", tmp_path / "record"
@@ -95,10 +97,31 @@ def test_scaling_2d_report(tmp_path):
                 (runs / f"{example}_n{row['n']}_p{ranks}_auto.json").write_text(json.dumps(row))
     (runs / "2.1-ex1_n10_p1_auto_same.json").write_text(json.dumps(
         {**real, "tag": "same", "options": ["-mech_amg_rebuild_its", "0"]}))
+    import itertools
+    module = _scaling_2d()
+    readme = tmp_path / "README.md"
+    readme.write_text(f"before\n{module.README_BEGIN}\nold\n{module.README_END}\nafter\n")
     proc = subprocess.run([sys.executable, str(script), "report", "--out", str(out),
-                           "--record", str(record)], cwd=REPO, capture_output=True, text=True,
-                          timeout=120)
+                           "--record", str(record), "--readme", str(readme)], cwd=REPO,
+                          capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
+    efficiency = (record / "efficiency.md").read_text().splitlines()
+    one, two = 0.1 * 64 ** 1.1, 0.1 * 64 ** 0.9  # 640 000 unknowns, c N^1.1 and c N^0.9
+    setup = real["start_s"] + real["first_step_s"]  # the derived rows keep the real run's
+    assert (f"| 3.1-ex1 | 400 | 640 000 | {one:.3g} ({one:.3g}-{one:.3g}) | "
+            f"{two:.3g} ({two:.3g}-{two:.3g}) | {one / two:.2f} | {one / two / 2:.2f} | "
+            f"{setup:.3g} / {setup:.3g} |") in efficiency, efficiency
+    text = readme.read_text().splitlines()
+    assert text[:2] == ["before", module.README_BEGIN] and text[-2:] == [module.README_END,
+                                                                         "after"]
+    assert "old" not in text and any("scaling_2d.py run 3.1-ex1 --n $n --ranks 2" in line
+                                     for line in text)
+    for marker in ("scaling.md", "efficiency.md"):  # each table copied from its record
+        i = next(i for i, line in enumerate(text) if line.startswith("<!-- record: ")
+                 and line.endswith(f"{marker} -->"))
+        table = list(itertools.takewhile(lambda line: line.startswith("|"), text[i + 1:]))
+        source = (record / marker).read_text().splitlines()
+        assert len(table) >= 3 and all(line in source for line in table)
     scaling = (record / "scaling.md").read_text()
     rows = [line for line in scaling.splitlines() if line.startswith("| ")]
     assert sum(line.startswith(("| 1 | ", "| 2 | ")) for line in rows) == 17  # 2 x 8 + n = 10
@@ -108,7 +131,6 @@ def test_scaling_2d_report(tmp_path):
     assert "| 2.1-ex1 | 1 | 10 |" in variants and "1.00 |" in variants
     assert "0.0e+00, 0.0e+00" in variants
     assert (record / "scaling.png").stat().st_size > 0
-    module = _scaling_2d()
     rows = [{"dofs_u": d, "step_median_s": 2.0 * d ** 1.25} for d in (5e3, 2e4, 8e4, 3.2e5)]
     assert abs(module.fit(rows) - 1.25) < 1e-12
     assert np.allclose(module.local_slopes(rows), [1.25, 1.25])

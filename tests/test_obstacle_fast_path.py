@@ -118,8 +118,8 @@ RUN = ["run", "3.1-ex2", "--n", "6", "--T", "0.3", "--no-figures", "--quiet"]
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs the CLI itself")
 def test_run_to_zeta_star_serial_two_ranks_and_snes(tmp_path):
     """3.1-ex2 until a fifth of the nodes sit at zeta_star (the active set grows, some steps go
-    to the SNES): the fast path with its default solvers (serially: Cholesky of B for an empty
-    active set; on 2 ranks: CG), with CG only (the SNES's Newton step: equal bit for bit) and
+    to the SNES): the fast path with its default solvers (Cholesky of B for an empty active set:
+    PETSc's serially, MUMPS's on 2 ranks), with CG only (the SNES's Newton step: equal bit for bit) and
     with Cholesky only, against the SNES alone."""
     runs = {"snes": (["-damage_vi_fast", "0"], 1), "s": ([], 1), "p": ([], 2),
             "cg": (["-damage_vi_fast_solver", "cg"], 1),

@@ -16,18 +16,23 @@ Modes: ``auto`` (the package's rule), ``direct`` (every system factorised:
 ``-<prefix>amg_min_dofs`` above any size), ``amg`` (every system of the rule on CG + AMG:
 ``-<prefix>amg_min_dofs 0``).
 
-Time per step: the median of history.csv's ``step_time_s`` over the steps after the first (step
-0, the t = 0 state, factorises; step 1 sets up AMG hierarchies; both are listed apart, beside
-the whole process's wall time, which carries the mesh and form set-up), the mean (which carries
-the occasional re-factorisation of 2.1's lagged elasticity solver) and the range beside it.
+Time per step: the median of history.csv's ``step_time_s`` over the timed steps (from
+FIRST_TIMED on: 2.1-ex1 steps 2-10; 3.1-ex1 steps 21-32, after its start-up transient, pressed
+into the obstacle and damaging in every one; step 0, the t = 0 state, factorises; step 1 sets
+up AMG hierarchies; both are listed apart, beside the whole process's wall time, which carries
+the mesh and form set-up), the mean (which carries the occasional re-factorisation of 2.1's
+lagged elasticity solver) and the range beside it.
 The cost of a 100-step run: step 0 (the t = 0 state) + step 1 + 99 later steps.
 ``report`` writes ``scaling.md`` (per example and ranks, the rule's runs; the exponent of the
 time per step against the unknowns, least squares on log-log from 1e4 to 1.2e6 unknowns, and the
-local slopes between neighbouring sizes), ``crossover.md`` (direct against AMG per size),
+local slopes between neighbouring sizes), ``efficiency.md`` (serial against 2 ranks per size:
+speed-up and parallel efficiency), ``crossover.md`` (direct against AMG per size),
 ``difference.md`` (u and zeta of the two solvers, relative, at the sizes where both ran) and
 ``variants.md`` (each run with ``--tag NAME --options '...'``, a solver option set, against the
 untagged run of the same size: time per step, iterations, the answers' difference) from all JSON
-files present, plus ``scaling.png``.
+files present, plus ``scaling.png``; and it rewrites the block between the scaling markers of
+benchmarks/README.md (the commands, the exponents and the serial / 2-rank table, copied from
+the records; ``--readme ''`` leaves it alone).
 """
 from __future__ import annotations
 
@@ -56,6 +61,14 @@ EXAMPLES = {
     "3.1-ex1": (0.005, ["--set", "stability_check=off"], ("mech_",),
                 {"mech_its": "CG its velocity", "damage_its": "Newton its damage"}),
 }
+#: example -> the first timed step (history.csv's step; step 0 is the t = 0 state, step 1 sets
+#: up). 3.1-ex1: steps 1-20 (t <= 0.1) are a transient whose cost per step changes (the first
+#: steps before damage starts are cheaper, those where it starts dearer); from step 21
+#: (t = 0.105) on, the body is pressed into the obstacle (RMS penetration >= 1e-4, rising) and
+#: the damage grows in every step, so every timed step does the same work.
+FIRST_TIMED = {"2.1-ex1": 2, "3.1-ex1": 21}
+#: example -> the default number of steps of a run: 9 and 12 timed steps
+DEFAULT_STEPS = {"2.1-ex1": 10, "3.1-ex1": 32}
 MODES = ("auto", "direct", "amg")
 #: a size above any mesh: ``direct`` factorises every system
 NEVER = 10 ** 15
@@ -99,7 +112,8 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
     with open(run / "history.csv") as f:
         rows = list(csv.DictReader(f))
     times = [float(r["step_time_s"]) for r in rows]  # step 0 (t = 0 state), 1, 2, ...
-    later = times[2:]
+    first = FIRST_TIMED[example]
+    later = times[first:]
     its = {c: [int(float(r[c])) for r in rows[1:] if r.get(c) not in (None, "")]
            for c in columns}
     rss = [int(v) / 1024.0 for v in re.findall(r"peak_rss_kb=(\d+)", proc.stderr)]
@@ -109,7 +123,7 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
             "dofs_u": mesh["dofs_u"], "dofs_zeta": mesh["dofs_zeta"],
             "command": (f"mpirun -n {ranks} " if ranks > 1 else "") + " ".join(
                 cmd[cmd.index(sys.executable):]),
-            "step_times_s": times, "step_s": float(np.mean(later)),
+            "step_times_s": times, "first_timed": first, "step_s": float(np.mean(later)),
             "step_median_s": float(np.median(later)),
             "step_min_s": float(np.min(later)), "start_s": times[0], "first_step_s": times[1],
             "run100_s": times[0] + times[1] + (RUN_STEPS - 1) * float(np.mean(later)),
@@ -123,9 +137,15 @@ def measure(example: str, n: int, ranks: int, mode: str, steps: int, folder: Pat
 def load(out: Path) -> list:
     rows = [json.loads(p.read_text()) for p in (out / "runs").glob("*.json")]
     for r in rows:  # the per-step median and tag (records written before they were stored)
-        r.setdefault("step_median_s", float(np.median(r["step_times_s"][2:])))
+        r.setdefault("first_timed", 2)
+        r.setdefault("step_median_s", float(np.median(timed(r))))
         r.setdefault("tag", "")
     return sorted(rows, key=lambda r: (r["example"], r["ranks"], r["mode"], r["dofs_u"]))
+
+
+def timed(r) -> list:
+    """The timed steps' times of run r (from its first timed step on)."""
+    return r["step_times_s"][r["first_timed"]:]
 
 
 def in_fit(rows) -> list:
@@ -180,7 +200,7 @@ def scaling_table(rows, mode="auto") -> list:
         lines += [f"**{example}** (k = {sel[0]['k']:g}, {sel[0]['steps']} steps, {mode})", "",
                   "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         for r in sel:
-            later = r["step_times_s"][2:]
+            later = timed(r)
             cells = [r["ranks"], r["n"], _dofs(r["dofs_u"]), _dofs(r["dofs_u"] + r["dofs_zeta"]),
                      f"{r['step_median_s']:.3g} ({min(later):.3g}-{max(later):.3g})",
                      f"{r['step_s']:.3g}", f"{r['start_s']:.3g} / {r['first_step_s']:.3g}",
@@ -213,17 +233,97 @@ def exponent_table(rows, mode="auto") -> list:
     return lines + [""]
 
 
+def efficiency_table(rows, mode="auto") -> list:
+    """Per example and size: the time per step serially and on 2 ranks (median, min-max of the
+    timed steps), the speed-up (serial / 2 ranks) and the parallel efficiency (speed-up / 2)."""
+    head = ["example", "n", "dofs u", "serial: time/step [s] median (min-max)",
+            "2 ranks: time/step [s] median (min-max)", "speed-up 1 -> 2 ranks",
+            "parallel efficiency", "step 0 + step 1 [s] serial / 2 ranks"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+
+    def cell(r):
+        if r is None:
+            return "-"
+        t = timed(r)
+        return f"{r['step_median_s']:.3g} ({min(t):.3g}-{max(t):.3g})"
+
+    for example in EXAMPLES:
+        sel = [r for r in rows if r["example"] == example and r["mode"] == mode]
+        by = {(r["n"], r["ranks"]): r for r in sel}
+        for n in sorted({r["n"] for r in sel}):
+            one, two = by.get((n, 1)), by.get((n, 2))
+            ref = one or two
+            speed = one["step_median_s"] / two["step_median_s"] if one and two else None
+            setup = " / ".join("-" if r is None else f"{r['start_s'] + r['first_step_s']:.3g}"
+                               for r in (one, two))
+            cells = [example, n, _dofs(ref["dofs_u"]), cell(one), cell(two),
+                     "-" if speed is None else f"{speed:.2f}",
+                     "-" if speed is None else f"{speed / 2:.2f}", setup]
+            lines.append("| " + " | ".join(str(c) for c in cells) + " |")
+    return lines + [""]
+
+
+def commands(rows, mode="auto") -> list:
+    """The script's commands that measured the rule's runs: one loop per example and ranks."""
+    lines = []
+    for example in EXAMPLES:
+        for ranks in (1, 2, 3, 4):
+            sel = [r for r in rows if r["example"] == example and r["mode"] == mode
+                   and r["ranks"] == ranks]
+            if not sel:
+                continue
+            steps = sorted({r["steps"] for r in sel})
+            sizes = " ".join(str(r["n"]) for r in sorted(sel, key=lambda r: r["n"]))
+            extra = (f" --ranks {ranks}" if ranks > 1 else "") + (
+                f" --steps {steps[0]}" if len(steps) == 1
+                and steps[0] != DEFAULT_STEPS[example] else "")
+            lines.append(f"    for n in {sizes}; do .venv/bin/python "
+                         f"benchmarks/performance/scaling_2d.py run {example} --n $n{extra}; done")
+    return lines + ["    .venv/bin/python benchmarks/performance/scaling_2d.py report"]
+
+
+#: the lines of benchmarks/README.md between which ``report`` writes its block
+README_BEGIN = "<!-- scaling_2d.py report: begin (written by the report step) -->"
+README_END = "<!-- scaling_2d.py report: end -->"
+
+
+def readme_block(rows, record_name: str) -> list:
+    """The block ``report`` writes into the README: the commands, the exponents and the
+    serial / 2-rank table, each table marked with the record it is copied from."""
+    return (["**Commands** (each size is a separate process, one at a time on the machine; "
+             "`runs.json` has each run's own command line):", ""] + commands(rows) + [
+             "", f"**Exponents** (`{record_name}/scaling.md`, with every run's full row):", "",
+             f"<!-- record: {record_name}/scaling.md -->"] + exponent_table(rows) + [
+             f"**Serial and 2 ranks** (`{record_name}/efficiency.md`):", "",
+             f"<!-- record: {record_name}/efficiency.md -->"] + efficiency_table(rows))
+
+
+def write_readme(readme: Path, block: list) -> bool:
+    """Replace the lines between README_BEGIN and README_END of ``readme`` by ``block``;
+    False (and the file untouched) when the markers are missing."""
+    if not readme.is_file():
+        return False
+    lines = readme.read_text().splitlines()
+    if README_BEGIN not in lines or README_END not in lines:
+        return False
+    i, j = lines.index(README_BEGIN), lines.index(README_END)
+    readme.write_text("\n".join(lines[:i + 1] + block + lines[j:]) + "\n")
+    return True
+
+
 def solver_pairs(rows) -> dict:
     """(example, ranks, n) -> {"direct": row, "amg": row}: the ``direct`` run, else the rule's
     (``auto``) run where the rule factorises (below AMG_MIN_DOFS[2] unknowns), and the ``amg``
-    run."""
+    run, both of the same number of steps (a pair of different lengths is left out)."""
     from damage_dolfinx.numerics.scalable import AMG_MIN_DOFS
     pairs = {}
     for r in sorted(rows, key=lambda r: r["mode"] == "direct"):  # direct wins over auto
         role = "direct" if r["mode"] == "auto" and r["dofs_u"] < AMG_MIN_DOFS[2] else r["mode"]
         if role in ("direct", "amg"):
             pairs.setdefault((r["example"], r["ranks"], r["n"]), {})[role] = r
-    return pairs
+    # only runs of the same length compare (the same final time, the same timed steps)
+    return {key: both for key, both in pairs.items()
+            if len({r["steps"] for r in both.values()}) == 1}
 
 
 def crossover_table(rows) -> list:
@@ -342,13 +442,14 @@ def plot(rows, path: Path):
     figstyle.save(fig, path, title="2-D time per step against unknowns")
 
 
-def report(out: Path, record: Path):
+def report(out: Path, record: Path, readme: Path = None):
     every = load(out)
     rows = [r for r in every if not r["tag"]]
     record.mkdir(parents=True, exist_ok=True)
     stamp = f"{time.strftime('%Y-%m-%d')}, commit {commit()}"
     (record / "scaling.md").write_text("\n".join(
         [f"<!-- {stamp}; scaling_2d.py report -->", ""] + scaling_table(rows)) + "\n")
+    (record / "efficiency.md").write_text("\n".join(efficiency_table(rows)) + "\n")
     (record / "crossover.md").write_text("\n".join(crossover_table(rows)) + "\n")
     (record / "difference.md").write_text("\n".join(difference(rows)) + "\n")
     (record / "variants.md").write_text("\n".join(variants_table(every)) + "\n")
@@ -356,8 +457,15 @@ def report(out: Path, record: Path):
         [{k: v.replace(f"{REPO}/", "") if k == "command" else v for k, v in r.items()
           if k != "folder"} for r in every], indent=1))
     plot(rows, record / "scaling.png")
-    for name in ("scaling.md", "crossover.md", "difference.md", "variants.md"):
+    for name in ("scaling.md", "efficiency.md", "crossover.md", "difference.md", "variants.md"):
         print((record / name).read_text())
+    if readme is not None:
+        try:  # the record's name as the README (in benchmarks/) refers to it
+            name = record.resolve().relative_to(readme.resolve().parent).as_posix()
+        except ValueError:
+            name = record.as_posix()
+        done = write_readme(readme, readme_block(rows, name))
+        print(f"{readme}: {'scaling block written' if done else 'no scaling block markers'}")
 
 
 def main(argv=None):
@@ -368,7 +476,8 @@ def main(argv=None):
     one.add_argument("--n", type=int, required=True)
     one.add_argument("--ranks", type=int, default=1)
     one.add_argument("--mode", choices=MODES, default="auto")
-    one.add_argument("--steps", type=int, default=6)
+    one.add_argument("--steps", type=int, default=None,
+                     help="steps of the run (default: DEFAULT_STEPS of the example)")
     one.add_argument("--force", action="store_true")
     one.add_argument("--tag", default="", help="name of a variant (a solver option set): its "
                      "runs are compared with the untagged run of the same size")
@@ -377,19 +486,25 @@ def main(argv=None):
     rep = sub.add_parser("report", help="tables, fit and plot from the measured runs")
     rep.add_argument("--record", default=str(REPO / "benchmarks" / "reference_output"
                                              / "scaling_2d"))
+    rep.add_argument("--readme", default=str(REPO / "benchmarks" / "README.md"),
+                     help="the README whose scaling block (between its markers) is rewritten; "
+                     "'' for none")
     for p in (one, rep):
         p.add_argument("--out", default=str(REPO / "results" / "scaling_2d"))
     args = parser.parse_args(argv)
     out = Path(args.out)
     if args.command == "report":
-        report(out, Path(args.record))
+        report(out, Path(args.record), Path(args.readme) if args.readme else None)
         return
     target = out / "runs" / (run_name(args.example, args.n, args.ranks, args.mode, args.tag)
                              + ".json")
     if target.exists() and not args.force:
         print(f"kept {target}")
         return
-    row = measure(args.example, args.n, args.ranks, args.mode, args.steps, out / "folders",
+    steps = args.steps or DEFAULT_STEPS[args.example]
+    if steps <= FIRST_TIMED[args.example]:
+        parser.error(f"--steps must exceed {FIRST_TIMED[args.example]} (the first timed step)")
+    row = measure(args.example, args.n, args.ranks, args.mode, steps, out / "folders",
                   args.options.split(), args.tag)
     target.parent.mkdir(parents=True, exist_ok=True)
     target.write_text(json.dumps(row, indent=1))

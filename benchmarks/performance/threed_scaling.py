@@ -9,7 +9,8 @@ against dofs and the extrapolation to a 10^8-dof cluster run.
 
 Each size is one ``damage-dolfinx run`` of a few steps (quasistatic k = 0.1, 4 steps; dynamic
 k = 0.01, 6 steps, ``stability_check=off``: the SLEPc eigenvalue estimate is a check, not part of
-the scheme) with ``/usr/bin/time`` around every rank. Time per step: of the steps after the
+the scheme) with GNU time (``/usr/bin/time``, where installed: peak memory and CPU time)
+around every rank. Time per step: of the steps after the
 first (the first sets up the AMG hierarchies; it is listed apart): the fastest of them, the
 median beside it; iterations per solve from
 history.csv (one elasticity or velocity solve and one damage solve per step); set-up: the run's
@@ -51,8 +52,11 @@ FIT_FROM_DOFS = 1e4
 def measure(kind: str, n: int, ranks: int, folder: Path) -> dict:
     example, args, columns, _ = KINDS[kind]
     run = folder / f"run_n{n}_p{ranks}"
-    cmd = ["/usr/bin/time", "-f", "peak_rss_kb=%M cpu_s=%U+%S", sys.executable, "-m",
-           "damage_dolfinx.cli", "run", example, "--n", str(n), *args, "--no-figures", "--quiet",
+    # peak memory and CPU time per rank from GNU time where it is installed (the DOLFINx 0.9
+    # and 0.11 roots and a bare machine have none: no memory column, CPU time nan)
+    timer = (["/usr/bin/time", "-f", "peak_rss_kb=%M cpu_s=%U+%S"]
+             if os.path.exists("/usr/bin/time") else [])
+    cmd = [*timer, sys.executable, "-m", "damage_dolfinx.cli", "run", example, "--n", str(n), *args, "--no-figures", "--quiet",
            "--write-every", "1000", "--checkpoint-seconds", "0", "--overwrite", "--out", str(run)]
     if ranks > 1:
         cmd = ["mpirun", "-n", str(ranks)] + cmd
@@ -67,7 +71,8 @@ def measure(kind: str, n: int, ranks: int, folder: Path) -> dict:
     times = [float(r["step_time_s"]) for r in rows]
     rss = [int(v) / 1024.0 for v in re.findall(r"peak_rss_kb=(\d+)", proc.stderr)]
     cpu = sum(float(u) + float(s)
-              for u, s in re.findall(r"cpu_s=([\d.]+)\+([\d.]+)", proc.stderr))
+              for u, s in re.findall(r"cpu_s=([\d.]+)\+([\d.]+)", proc.stderr)) \
+        if timer else float("nan")
     mesh = summary["mesh"]
     its = {c: [int(r[c]) for r in rows if r.get(c) not in (None, "")] for c in columns}
     return {"kind": kind, "example": example, "n": n, "ranks": ranks,
@@ -100,8 +105,11 @@ def fit(rows, key="step_s") -> tuple:
 
 
 def kb_per_vertex(row) -> float:
-    """Peak memory of all ranks above 200 MB base per rank, per mesh vertex."""
+    """Peak memory of all ranks above 200 MB base per rank, per mesh vertex (nan where the
+    peak memory was not measured)."""
     rss = row["peak_rss_mb_per_rank"]
+    if not rss:
+        return float("nan")
     return (sum(rss) - 200.0 * len(rss)) * 1024.0 / row["vertices"]
 
 
@@ -124,7 +132,8 @@ def table(kind: str, rows) -> str:
                  f"{r['dofs_u'] + r['dofs_zeta']:,}".replace(",", " "),
                  f"{r['step_s']:.3g} ({r['step_median_s']:.3g})", f"{r['first_step_s']:.3g}"]
         cells += [its_text(r["its"][c]) for c in columns]
-        cells += [f"{max(r['peak_rss_mb_per_rank']):.0f}", f"{r['setup_s']:.3g}",
+        cells += [f"{max(r['peak_rss_mb_per_rank'] or [float('nan')]):.0f}",
+                  f"{r['setup_s']:.3g}",
                   f"{r['process_s']:.3g} / {r.get('process_cpu_s', float('nan')):.3g}"]
         lines.append("| " + " | ".join(str(c) for c in cells) + " |")
     lines.append("")
@@ -155,7 +164,8 @@ def plot(kind: str, rows, path: Path):
             a2.semilogx(d, [max(r["its"][col]) if r["its"][col] else np.nan for r in sel],
                         marker, color=colour, mfc=colour if ranks == 1 else "none",
                         ms=7 if ranks == 1 else 10, label=f"{label}, {ranks} rank(s)")
-        a3.loglog(d, [max(r["peak_rss_mb_per_rank"]) for r in sel], "o-", color=colour,
+        a3.loglog(d, [max(r["peak_rss_mb_per_rank"] or [np.nan]) for r in sel], "o-",
+                  color=colour,
                   label=f"{ranks} rank(s)")
     d = np.array([r["dofs_u"] for r in rows], float)
     if d.size:

@@ -43,7 +43,8 @@ from damage_dolfinx.compat.assembly import (  # noqa: E402,F401
     assemble_matrix, apply_lifting, set_bc, form, assemble_scalar,
     bc_dofs)
 from damage_dolfinx.compat.meshes import (  # noqa: E402,F401
-    create_rectangle, create_box, create_tet_mesh, create_submesh, locate_entities_boundary,
+    create_rectangle, create_box, create_simplex_mesh, create_tet_mesh, create_submesh,
+    locate_entities_boundary,
     locate_entities, cell_diameters, meshtags, cell_midpoints, num_owned_cells,
     cell_vertex_coords, cell_dofs, model_to_mesh, xdmf_file, read_msh,
     dofs_in_cells, facet_coords, facet_vertex_coords)

@@ -23,23 +23,33 @@ def create_box(comm, p0, p1, n):
                             dmesh.CellType.tetrahedron)
 
 
-def create_tet_mesh(comm, cells, x):
-    """P1 tetrahedral mesh from this rank's cells (int64 global vertex numbers) and this rank's
-    block of vertex coordinates ``x`` (rank r's rows are the vertices offset_r, offset_r + 1, ...,
-    offsets in rank order), partitioned and ghosted (shared facets) like ``create_box``."""
+def create_simplex_mesh(comm, cells, x):
+    """P1 triangle (``cells`` with 3 columns, ``x`` with 2) or tetrahedron (4 columns, 3) mesh
+    from this rank's cells (int64 global vertex numbers) and this rank's block of vertex
+    coordinates ``x`` (rank r's rows are the vertices offset_r, offset_r + 1, ..., offsets in
+    rank order), partitioned and ghosted (shared facets) like ``create_rectangle`` and
+    ``create_box``."""
     mode = dmesh.GhostMode.shared_facet
-    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 4)
-    x = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+    cells = np.asarray(cells, dtype=np.int64)
+    nv = cells.shape[1]
+    cell, gdim = {3: ("triangle", 2), 4: ("tetrahedron", 3)}[nv]
+    cells = cells.reshape(-1, nv)
+    x = np.ascontiguousarray(np.asarray(x, dtype=np.float64).reshape(-1, gdim))
     if "domain" in inspect.signature(dmesh.create_mesh).parameters:  # 0.5-0.6
-        domain = ufl.Mesh(ufl.VectorElement("Lagrange", ufl.tetrahedron, 1))
+        domain = ufl.Mesh(ufl.VectorElement("Lagrange", getattr(ufl, cell), 1))
         return dmesh.create_mesh(comm, cells, x, domain, ghost_mode=mode)
     import basix.ufl
-    domain = ufl.Mesh(basix.ufl.element("Lagrange", "tetrahedron", 1, shape=(3,)))
+    domain = ufl.Mesh(basix.ufl.element("Lagrange", cell, 1, shape=(gdim,)))
     try:
         partitioner = dmesh.create_cell_partitioner(mode, 2)  # 0.10+: max facet-cell links
     except TypeError:
         partitioner = dmesh.create_cell_partitioner(mode)
     return dmesh.create_mesh(comm, cells=cells, x=x, e=domain, partitioner=partitioner)
+
+
+def create_tet_mesh(comm, cells, x):
+    """P1 tetrahedral mesh (:func:`create_simplex_mesh` with 4 vertices a cell)."""
+    return create_simplex_mesh(comm, np.asarray(cells, dtype=np.int64).reshape(-1, 4), x)
 
 
 def create_submesh(msh, dim, entities):

@@ -27,6 +27,7 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.numerics.contact_output import near_contact
 from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
 from damage_dolfinx.problem import Problem
@@ -119,7 +120,9 @@ class KelvinVoigtTresca(Model):
         candidate = self.comm.rank if local_best <= best else self.comm.size
         owner = self.comm.allreduce(candidate, op=MPI.MIN)
         index = int(np.argmin(dist)) if self.comm.rank == owner else None
-        residual = compat.form(residual_form)
+        # only its rows on Gamma_C are read: assembled over the cells that touch Gamma_C
+        residual = compat.form(near_contact(residual_form, self.v.function_space,
+                                            self.data.geometry.facet_tags))
         self._probe = (nodes, index, residual, compat.create_vector(residual))
 
     def scalars(self) -> dict:

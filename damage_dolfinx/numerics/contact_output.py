@@ -49,6 +49,39 @@ from damage_dolfinx.numerics.contact import (NODAL_QUADRATURE, NODAL_QUADRATURE_
 PRESSURE_DEGREE = 2
 
 
+#: cell tag of the strip of cells that touch Gamma_C (:func:`near_contact`)
+STRIP = 1
+
+
+def near_contact(form, V, facet_tags):
+    """``form`` (UFL, linear in a test function of V) with its cell integrals restricted to the
+    owned cells that have a node on Gamma_C: the same entries at every node of Gamma_C (each
+    gathers the cells around it; only the order of the sums changes), an assembly over a strip
+    of cells instead of the whole mesh (2.2 Ex. 1 at n = 128: 3.5 -> 0.3 ms). Facet integrals
+    are kept as they are. ``form`` unchanged where a cell integral already has a subdomain."""
+    cells = [itg for itg in form.integrals() if itg.integral_type() == "cell"]
+    if not cells or any(itg.subdomain_id() not in ("everywhere", "otherwise")
+                        or itg.subdomain_data() is not None for itg in cells):
+        return form
+    msh = V.mesh
+    w = ufl.TestFunction(compat.scalar_p1(msh))
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+    marker = compat.create_vector(compat.form(w * ds(GAMMA_C)))
+    with marker.localForm() as local:
+        local.set(0.0)
+    compat.assemble_vector(marker, compat.form(w * ds(GAMMA_C)))
+    marker.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    marker.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+    with marker.localForm() as local:
+        on_gamma_c = local.array.copy() > 0
+    marker.destroy()
+    Z = w.ufl_function_space()
+    strip = np.flatnonzero(on_gamma_c[compat.cell_dofs(Z)].any(axis=1))
+    tags = compat.meshtags(msh, msh.topology.dim, strip, np.full(strip.size, STRIP))
+    return ufl.Form([itg.reconstruct(subdomain_id=STRIP, subdomain_data=tags)
+                     if itg.integral_type() == "cell" else itg for itg in form.integrals()])
+
+
 def _assemble(form):
     """Owned entries of an assembled vector (ghost contributions added)."""
     vec = compat.create_vector(form)
@@ -83,6 +116,8 @@ class ContactOutput:
         dsq = ufl.Measure("ds", domain=msh, subdomain_data=tags,
                           metadata={"quadrature_degree": PRESSURE_DEGREE})
         force = -pressure * ufl.dot(n, w) * dsq(GAMMA_C) if self.compliance else residual
+        if not self.compliance and not isinstance(force, tuple):
+            force = near_contact(force, self.V, tags)  # only its rows on Gamma_C are read
         self._force = force if isinstance(force, tuple) else compat.form(force)
         self.slip_rate, self.eps_slip = slip_rate, eps_slip
         self.columns = self.names(self.dim, slip_rate is not None)

@@ -20,7 +20,8 @@ otherwise; this also covers the wrench, lam_D = 0, where zeta stays within round
 a while). Its linear algebra is cached:
 
 * empty active set (most steps of every problem; the wrench never reaches zeta_star): B itself,
-  factorised once per run (PETSc Cholesky, nested dissection, serial, up to CHOLESKY_MAX_DOFS),
+  factorised once per run (Cholesky: PETSc's, nested dissection, serially; MUMPS's on several
+  ranks; up to CHOLESKY_MAX_DOFS),
   one pair of triangular solves per step;
 * otherwise B_II, extracted and given the SNES's own KSP (type, preconditioner, tolerances: the
   SNES's Newton step bit for bit) once per active set and kept while the set stays the same.
@@ -53,11 +54,16 @@ VI_BOUND_WINDOW = 1e-8
 #: largest violation of a bound by a free value that is projected (round-off); beyond it the
 #: step goes to the SNES
 FEASIBILITY_TOL = 1e-10
-#: largest size (by dimension) whose full matrix B is factorised (Cholesky, serial): at 65k
-#: dofs in 2-D the factorisation (nested dissection) takes 0.6 s once and a solve 4 ms, against
-#: 10-20 ms for the CG the SNES runs; 3-D factors fill faster
-CHOLESKY_MAX_DOFS = {2: 300_000, 3: 30_000}
-#: auto: Cholesky for the full B (serial, up to CHOLESKY_MAX_DOFS), the SNES's CG for reduced
+#: largest size (by dimension) whose full matrix B is factorised (Cholesky: PETSc's serially,
+#: MUMPS's on several ranks): at 65k dofs in 2-D the factorisation (nested dissection) takes
+#: 0.6 s once and a solve 4 ms, against 10-20 ms for the CG the SNES runs. The CG's iterations
+#: grow with the mesh (B = M + k kappa K: its condition grows like 1/h^2), so its cost per step
+#: grows like N^1.5: 3.1-ex1, 32 steps, serially, at 321 489 scalar dofs 1.14 s a step with CG
+#: against 0.14 s at 160 801 with the factorisation. In 2-D the bound is the damage space of a
+#: mesh whose vector space reaches the rule's AMG_MIN_DOFS[2] (2e6, numerics/scalable.py), whose
+#: factorisations are kept to that size; 3-D factors fill faster
+CHOLESKY_MAX_DOFS = {2: 1_000_000, 3: 30_000}
+#: auto: Cholesky for the full B (up to CHOLESKY_MAX_DOFS), the SNES's CG for reduced
 #: systems; cholesky: factorise every system (one factorisation per new active set); cg: the
 #: SNES's CG for all (each accepted step then equals the SNES's bit for bit)
 SOLVERS = ("auto", "cholesky", "cg")
@@ -91,10 +97,10 @@ class ObstacleFastPath:
                  solver: str = "auto", max_direct: int = CHOLESKY_MAX_DOFS[2]):
         self.B, self.lb, self.ub = B, float(lb), float(ub)
         self.comm = B.getComm().tompi4py()
-        # Cholesky for the full B (once per run) in serial up to max_direct unknowns; the
-        # reduced B_II by the SNES's own CG (bit for bit its Newton step) unless asked
+        # Cholesky for the full B (once per run) up to max_direct unknowns; the reduced B_II by
+        # the SNES's own CG (bit for bit its Newton step) unless asked
         self.direct_full = solver == "cholesky" or (
-            solver == "auto" and self.comm.size == 1 and B.getSize()[0] <= max_direct)
+            solver == "auto" and B.getSize()[0] <= max_direct)
         self.direct_reduced = solver == "cholesky"
         self.snes_ksp = snes_ksp  # the CG copies its options prefix
         self.rstart = B.getOwnershipRange()[0]
