@@ -290,8 +290,8 @@ README_END = "<!-- scaling_2d.py report: end -->"
 def readme_block(rows, record_name: str) -> list:
     """The block ``report`` writes into the README: the commands, the exponents and the
     serial / 2-rank table, each table marked with the record it is copied from."""
-    return (["**Commands** (each size is a separate process, one at a time on the machine;",
-             "time per step and its fit: see above):", ""] + commands(rows) + [
+    return (["**Commands** (each size is a separate process, one at a time on the machine; "
+             "`runs.json` has each run's own command line):", ""] + commands(rows) + [
              "", f"**Exponents** (`{record_name}/scaling.md`, with every run's full row):", "",
              f"<!-- record: {record_name}/scaling.md -->"] + exponent_table(rows) + [
              f"**Serial and 2 ranks** (`{record_name}/efficiency.md`):", "",
