@@ -19,8 +19,9 @@ from damage_dolfinx.runtime.signals import RunInterrupted
 
 __all__ = ["InputError", "ConvergenceError", "OutputError", "RunInterrupted", "for_command_line"]
 
-#: API wording -> command-line wording, applied in this order
-_FLAGS = (("restart=True", "--restart"), ("overwrite=True", "--overwrite"),
+#: API wording -> command-line wording, applied in this order (the command line's refusal already
+#: states k_max: the API's way to ask for it before a run is left out there)
+_FLAGS = ((" (problem.k_max() gives k_max before the run)", ""), ("restart=True", "--restart"), ("overwrite=True", "--overwrite"),
           ("allow_unstable=True", "--allow-unstable"), ("allow_long=True", "--allow-long"),
           ("another out folder", "another --out"), ("checkpoint_seconds", "--checkpoint-seconds"),
           ("checkpoint_every", "--checkpoint-every"), ("write_every", "--write-every"),

@@ -74,5 +74,6 @@ def check_plot(plot, problem, geometry, comm, what="plot"):
         return
     names = final_scalar_names(problem, geometry, comm)
     if plot not in names:
-        raise InputError(f"{what} {plot!r} is not a final scalar of {problem.id} (model "
-                         f"{problem.model_id}); known: {', '.join(names)}")
+        raise InputError(f"{what} {plot!r} is not one of the final scalars a run of "
+                         f"{problem.id!r} (model {problem.model_id}) reports: "
+                         f"{', '.join(names)}")

@@ -84,8 +84,11 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
     alone, under MPI, ends the job within seconds instead of leaving the others waiting). A
     plain ``for step in dd.steps(...)`` loop works too, but Python closes the run alike after a
     ``break`` and after an exception of the body (the run cannot tell them apart): both are
-    recorded as "stopped", and under MPI an exception on one rank only can leave the ranks
-    waiting for each other. Bad input raises InputError here, before any work."""
+    recorded as "stopped" when every rank leaves the loop at the same step. Under MPI the ranks
+    agree after every step whether their loops went on: a loop left on some ranks only (an
+    exception there) ends the others with an error, summary.json "failed" (without the text of
+    the exception, which only the ``with`` form sees). Bad input raises InputError here, before
+    any work."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.loop import Run
     from damage_dolfinx.runtime.steps import Steps

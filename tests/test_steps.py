@@ -93,3 +93,37 @@ def test_on_step_stops_the_run_after_a_few_steps(tmp_path):
     s = dd.run("2.1-ex1", out, on_step=lambda step: step.n == 2, **CASE)
     assert (s["status"], s["steps_done"]) == ("stopped", 2)
     assert summary(out)["status"] == "stopped"
+
+
+PLAIN = textwrap.dedent('''
+    import sys
+    from mpi4py import MPI
+    import damage_dolfinx as dd
+
+    out, how = sys.argv[1], sys.argv[2]
+    for step in dd.steps("2.1-ex1", out, n=5, k=0.25, T=1.0, progress=False, figures=False):
+        if step.n == 2 and (how == "break" or MPI.COMM_WORLD.rank == 1):
+            if how == "break":
+                break
+            raise RuntimeError("the loop body fails on rank 1")
+''')
+
+
+@pytest.mark.parametrize("how", ["raise", "break"])
+def test_a_plain_loop_on_2_ranks_never_leaves_a_rank_waiting(tmp_path, how):
+    """Without the with block a raise cannot be told from a break; the ranks agree after each
+    step whether their loops went on: a loop left on one rank only ends the others (failed),
+    a break on every rank is a stop."""
+    script, out = tmp_path / "mine.py", tmp_path / "o"
+    script.write_text(PLAIN)
+    start = time.monotonic()
+    proc = subprocess.run(["mpirun", "-n", "2", sys.executable, str(script), str(out), how],
+                          capture_output=True, text=True, env=ENV, timeout=60)
+    assert time.monotonic() - start < 30, proc.stderr
+    s = summary(out)
+    if how == "break":
+        assert proc.returncode == 0, proc.stderr
+        assert (s["status"], s["steps_done"]) == ("stopped", 2), s
+    else:
+        assert proc.returncode != 0
+        assert s["status"] == "failed" and "ended on rank(s) 1 at step 2" in s["error"], s

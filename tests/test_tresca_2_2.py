@@ -34,7 +34,17 @@ def test_damage_bounds_and_serial_equals_two_ranks(tmp_path):
     assert s["zeta"].min() >= 0.01 - 1e-12 and s["zeta"].max() <= 1 + 1e-12
     assert s["zeta"].min() <= 0.01 + 1e-9
     with open(tmp_path / "s" / "history.csv") as f:
-        assert min(float(r["zeta_min"]) for r in csv.DictReader(f)) >= 0.01 - 1e-12
+        serial = list(csv.DictReader(f))
+    assert min(float(r["zeta_min"]) for r in serial) >= 0.01 - 1e-12
+    # the contact forces (assembled over the cells that touch Gamma_C, ghost cells included)
+    # are the same on 2 ranks
+    with open(tmp_path / "p" / "history.csv") as f:
+        parallel = list(csv.DictReader(f))
+    for column in ("contact_normal_force", "contact_force_x", "contact_force_y",
+                   "friction_force"):
+        a = np.array([float(r[column]) for r in serial])
+        b = np.array([float(r[column]) for r in parallel])
+        assert np.abs(a - b).max() <= 1e-7 * np.abs(a).max(), column
 
 
 def test_uzawa_is_refused_without_gamma_D(tmp_path):

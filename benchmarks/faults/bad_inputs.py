@@ -2,7 +2,7 @@
 its exit status, its message (the first line of stderr), the files of its folder before and
 after, and the outcome. Writes bad_inputs.json and bad_inputs.md beside this script.
 
-    python benchmarks/faults/bad_inputs.py [--only ID ...] [--out DIR]
+    python benchmarks/faults/bad_inputs.py [--only ID ...] [--start I] [--stop J] [--out DIR]
 
 Outcomes: ``refused`` (exit status 2, one line, nothing written or changed), ``failed`` (exit
 status 3, one line, summary.json "failed" with the error), ``warned`` (exit status 0 and one
@@ -858,8 +858,8 @@ def kind(r) -> str:
 
 #: the table's history (rows run on an earlier code), kept when it is written again
 NOTES = [
-    "Rows 1-93 are the command line's earlier table (recorded before the rows below were added; "
-    "its fast cases run in tests/test_bad_inputs.py). Rows 94-188 (the API, sweeps, converge, "
+    "Rows 1-93 are the command line's earlier table (its fast cases run in "
+    "tests/test_bad_inputs.py). Rows 94-188 (the API, sweeps, converge, "
     "restarts, mesh files, signals of state and MPI) were also run on the code before the "
     "validation layer, the collective outcome, the sweep folder rules and the run fingerprint "
     "(`python benchmarks/faults/bad_inputs.py --start 93 --timeout 60` in a checkout of that "
@@ -884,9 +884,20 @@ NOTES = [
     "short left so, converge(progress='no'), sweep --plot of an unknown scalar), 3 other (a "
     "valid restart refused: a tag [2] for 2; a refusal after files were written: a mesh file "
     "with a node moved; a user's on_step raising left the summary without the error), 0 hang, "
-    "0 user file lost; now 125 clean. Still open: sweep --plot of an unknown scalar warns "
-    "after the runs instead of refusing before them (the final scalars are known only once a "
-    "model is built).", "",
+    "0 user file lost; now 126 clean (sweep --plot of an unknown scalar was the last one open: "
+    "it warned after the runs, the final scalars being known only once a model was built; they "
+    "are now known from the model class and the problem before any work, and the plot is "
+    "refused there).", "",
+    "Rows 315-320 are the two mechanisms added last: a sweep's plot checked against the final "
+    "scalars before any run (an unknown one refused, a contact scalar of a problem with a "
+    "contact part accepted), and `with dd.steps(...) as run:`, whose exit sees an exception of "
+    "the loop body (failed, with the error; on 2 ranks a raise on rank 1 alone ends both ranks "
+    "with one line), a break being a stop; a plain `for step in dd.steps(...)` loop raising on "
+    "rank 1 alone ends both ranks too (the ranks agree after every step whether their loops "
+    "went on; on the code before, it had not ended after 40 s).", "",
+    "Every row below is the result of the current code: the table is written again whole, in "
+    "chunks (`python benchmarks/faults/bad_inputs.py --start 0 --stop 100`, then `--start 100 "
+    "--stop 200`, then `--start 200`; each chunk merged into the table as last recorded).", "",
 ]
 
 

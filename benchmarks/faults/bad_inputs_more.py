@@ -412,6 +412,13 @@ def more_cases(case_, api_, ns, none, copy, only_user, mesh, run, conv, sweep_ba
     api("2 ranks: steps() with-body raising on rank 1 only at step 1", "mpi",
         with_body.format(rank=" and MPI.COMM_WORLD.rank == 1"), expect="failed", fast=False,
         ranks=2)
+    api("2 ranks: a plain steps() loop raising on rank 1 only at step 1", "mpi",
+        "try:\n    for step in dd.steps(problem(T=0.04), 'o', figures=False, progress=False):\n"
+        "        if step.n == 1 and MPI.COMM_WORLD.rank == 1:\n"
+        "            raise RuntimeError('my own check fails')\n"
+        "except RuntimeError as exc:\n    if MPI.COMM_WORLD.rank == 0:\n"
+        "        print(f'damage-dolfinx: failed: {exc}', file=sys.stderr)\n    sys.exit(3)",
+        expect="failed", fast=False, ranks=2)
 
 
 if __name__ == "__main__":

@@ -36,7 +36,6 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from mpi4py import MPI
-from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.runtime import bookkeeping
@@ -349,20 +348,7 @@ class Model:
                 "zeta_mean": float(zeta_integral / area)}
 
     def _assemble_norm_operators(self):
-        V, Z = self.u.function_space, self.zeta.function_space
-        du, w = ufl.TrialFunction(V), ufl.TestFunction(V)
-        forms = [compat.form(ufl.inner(du, w) * ufl.dx),
-                 compat.form(ufl.inner(eps(du), eps(w)) * ufl.dx)]
-        mats = []
-        for a in forms:
-            mats.append(bookkeeping.norm_matrix(a, V.dofmap.index_map_bs))
-        m_form = compat.form(ufl.TestFunction(Z) * ufl.dx)
-        m = compat.create_vector(m_form)
-        with m.localForm() as ml:
-            ml.set(0.0)
-        compat.assemble_vector(m, m_form)
-        m.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        return (*mats, m, m.sum(), mats[0].createVecLeft())
+        return bookkeeping.norm_operators(self.u.function_space, self.zeta.function_space)
 
     # -- contact
     def contact_pressure(self):

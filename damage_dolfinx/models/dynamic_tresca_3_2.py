@@ -144,7 +144,7 @@ class DynamicTresca(Model):
         nodes = self.friction.nodes  # owned contact nodes with their unit tangents
         X = self.v.function_space.tabulate_dof_coordinates()[nodes.dofs].T
         self._faces = {name: np.flatnonzero(marker(X)) for name, marker in faces.items()}
-        self.extra_history_columns = ["friction_its"] + [f"u_tau_max_{name}" for name in faces]
+        self.extra_history_columns = self.declared_columns(self.data, self.mesh.topology.dim)
 
     def u_tau_max(self) -> dict:
         """max |u_tau| over the contact nodes of each named face (collective)."""

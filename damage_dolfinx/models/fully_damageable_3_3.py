@@ -182,7 +182,7 @@ class FullyDamageableContact(Model):
         if isinstance(line, dict):
             line = line.get(choice)
         self.profiles = DamageProfiles(Z, line, data.builders.get("profile_every", 0.5), self.k)
-        self.extra_history_columns = (["v_L2"] + self.contact.columns + self.probe.columns)
+        self.extra_history_columns = self.declared_columns(self.data, msh.topology.dim)
         self.timings = {"damage": 0.0, "velocity": 0.0,
                         "stability": self.stability.get("time_s", 0.0)}
         self._prefixes = damage_prefix, mech_prefix

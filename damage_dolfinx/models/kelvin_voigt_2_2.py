@@ -109,7 +109,7 @@ class KelvinVoigtTresca(Model):
 
     # -- a point on Gamma_C whose horizontal displacement and tangential stress are recorded
     def _probe_setup(self, point, residual_form):
-        self.extra_history_columns = []
+        self.extra_history_columns = self.declared_columns(self.data, self.mesh.topology.dim)
         if point is None:
             return
         nodes = self.friction.nodes  # contact nodes, weights and tangents of the solver
@@ -124,7 +124,6 @@ class KelvinVoigtTresca(Model):
         residual = compat.form(near_contact(residual_form, self.v.function_space,
                                             self.data.geometry.facet_tags))
         self._probe = (nodes, index, residual, compat.create_vector(residual))
-        self.extra_history_columns = ["probe_u1", "probe_sigma_tau"]
 
     def scalars(self) -> dict:
         out = super().scalars()

@@ -29,6 +29,7 @@ from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.problem import Problem
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
 from damage_dolfinx.parameters import ModelParameters
@@ -113,7 +114,7 @@ class ElastoViscoplasticFriction(Model):
 
         self.von_mises = fem.Function(compat.scalar_dg0(msh), name="von_mises")
         self._vm_expr = compat.expression(von_mises(self.sigma), self.von_mises.function_space)
-        self._stress_sq = compat.form(ufl.inner(self.sigma, self.sigma) * ufl.dx)
+        self._stress_sq = bookkeeping.PiecewiseConstantNorm(self.sigma)  # sigma_n: DG0
         self._contact_dofs = self._gamma_c_dofs(V, tags)
         self.output_fields = [self.u, self.zeta, self.von_mises, self.sigma]
         self.error_components = [("u", self.u, "V"), ("sigma", self.sigma, "L2"),
@@ -155,7 +156,7 @@ class ElastoViscoplasticFriction(Model):
         location of the most damaged node (lowest zeta; the first on ties)."""
         out = super().scalars()
         out["zeta_min_x"], out["zeta_min_y"] = self._most_damaged_point()
-        out["stress_Q"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
+        out["stress_Q"] = float(np.sqrt(self.comm.allreduce(self._stress_sq.local())))
         if self.mesh.topology.dim == 3:  # |u_tau| at the contact nodes (3-D)
             u1 = law.norm(self.friction.nodes.tangential(self.u))
         else:

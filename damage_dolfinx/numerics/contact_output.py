@@ -113,6 +113,8 @@ class ContactOutput:
         normal = _assemble(compat.form(ufl.dot(n, w) * ds(GAMMA_C))).reshape(-1, bs)
         normal = normal[self.nodes]
         self.nu = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        self._m_nodes = self.m[self.nodes]
+        self._tau = np.column_stack([-self.nu[:, 1], self.nu[:, 0]]) if self.dim == 2 else None
         dsq = ufl.Measure("ds", domain=msh, subdomain_data=tags,
                           metadata={"quadrature_degree": PRESSURE_DEGREE})
         force = -pressure * ufl.dot(n, w) * dsq(GAMMA_C) if self.compliance else residual
@@ -186,11 +188,12 @@ class ContactOutput:
             return cls.attach(stepper, residual=(mech.a, mech.L))
         return None
 
-    def _nodal(self):
-        """(F (nodes, dim), p (nodes,), F_tau (nodes, dim)) on the owned contact nodes."""
+    def _nodal(self, tangential=True):
+        """(F (nodes, dim), p (nodes,), F_tau (nodes, dim), or None without ``tangential``) on
+        the owned contact nodes."""
         F = self._forces().reshape(-1, self.dim)[self.nodes]
-        Fn = np.sum(F * self.nu, axis=1)
-        return F, -Fn / self.m[self.nodes], F - Fn[:, None] * self.nu
+        Fn = np.einsum("ij,ij->i", F, self.nu)
+        return F, -Fn / self._m_nodes, F - Fn[:, None] * self.nu if tangential else None
 
     def _forces(self):
         """Owned entries of the nodal force vector: an assembled linear form (into a vector
@@ -226,28 +229,25 @@ class ContactOutput:
         return out
 
     def scalars(self) -> dict:
-        F, p, F_tau = self._nodal()
-        m = self.m[self.nodes]
+        F, p, F_tau = self._nodal(tangential=self.slip_rate is not None)
+        m, d = self._m_nodes, self.dim
         owned = self.V.dofmap.index_map.size_local
-        un = np.sum(self.u.x.array[:owned * self.dim].reshape(-1, self.dim)[self.nodes]
-                    * self.nu, axis=1)
+        un = np.einsum("ij,ij->i", self.u.x.array[:owned * d].reshape(-1, d)[self.nodes], self.nu)
         if self.compliance:
             in_contact, penetration = p > 0, np.maximum(un - self.gap, 0.0)
         else:
             in_contact, penetration = None, np.abs(un)
-        sums = [np.sum(p * m), *F.sum(axis=0), np.sum(m[in_contact]) if self.compliance else 0.0]
+        sums = [np.dot(p, m), *F.sum(axis=0), np.sum(m[in_contact]) if self.compliance else 0.0]
         if self.slip_rate is not None:
-            v = self.slip_rate.x.array[:owned * self.dim].reshape(-1, self.dim)[self.nodes]
-            v_tau = v - np.sum(v * self.nu, axis=1)[:, None] * self.nu
-            sliding = np.linalg.norm(v_tau, axis=1) > self.eps_slip
-            if self.dim == 2:
-                tau = np.column_stack([-self.nu[:, 1], self.nu[:, 0]])
-                sums += [np.sum(F_tau * tau), np.sum(m[sliding])]
+            v = self.slip_rate.x.array[:owned * d].reshape(-1, d)[self.nodes]
+            v_tau = v - np.einsum("ij,ij->i", v, self.nu)[:, None] * self.nu
+            sliding = np.sqrt(np.einsum("ij,ij->i", v_tau, v_tau)) > self.eps_slip
+            if d == 2:
+                sums += [np.sum(F_tau * self._tau), np.sum(m[sliding])]
             else:
                 sums += [*F_tau.sum(axis=0), np.sum(m[sliding])]
         sums, (peak,) = bookkeeping.sums_and_maxima(
             self.comm, sums, [float(penetration.max()) if penetration.size else 0.0])
-        d = self.dim
         size = sums[d + 1] if self.compliance else self.length  # bilateral: all of Gamma_C
         out = {"contact_normal_force": sums[0], f"contact_{self._size}": size,
                "contact_penetration": peak,

@@ -23,6 +23,7 @@ from damage_dolfinx.runtime.runfolder import (RunLock, check_mesh_file, claim_fo
                                               previous_run)
 from damage_dolfinx.runtime.runner import CHECKPOINT_SECONDS, Step
 from damage_dolfinx.runtime.signals import StopSignals
+from damage_dolfinx.runtime.steps import together
 
 class Run(RunRecords):
     """One run into a folder: set up (:meth:`prepare`), then :meth:`steps`."""
@@ -66,6 +67,9 @@ class Run(RunRecords):
 
     #: the caller's code raised inside the loop (Run.abandon): no outputs of a stop
     abandoned = False
+    #: the ranks agree after every hand-over whether their callers left the loop (dd.steps
+    #: under MPI: runtime/steps.together)
+    handshake = False
 
     def abandon(self, steps):
         """End the generator ``steps`` after the caller's own code raised inside the loop: no
@@ -219,11 +223,13 @@ class Run(RunRecords):
             try:
                 yield Step(self)
             except GeneratorExit:
-                if self.abandoned:
+                if self.abandoned or not together(self, leaving=True):
                     raise
                 stop = "stopped"
                 if stepper.n < N and self.supported:
                     self.save_checkpoint()
+            else:
+                together(self, leaving=False)
             while stop is None and stepper.n < N:
                 stop, step = self._step()
                 if stop:
@@ -231,10 +237,12 @@ class Run(RunRecords):
                 try:  # here, not in _step: a close reaches a nested generator's caller too
                     yield Step(self)
                 except GeneratorExit:  # the caller stopped here: the outputs of a stop
-                    if self.abandoned:
+                    if self.abandoned or not together(self, leaving=True):
                         raise
                     self._outputs("stopped", *step)
                     stop = "stopped"
+                else:
+                    together(self, leaving=False)
             self._finish(stop)
         except (ConvergenceError, io.OutputError) as exc:
             self._failed(exc)

@@ -4,10 +4,14 @@
 Why the context manager. When a plain ``for step in dd.steps(...)`` loop ends, Python closes
 the run's generator in the same way whether the loop body executed ``break`` or raised: the
 generator receives ``GeneratorExit`` with the caller's exception out of its sight (CPython
-stores the exception in flight while it finalises the generator). A raise is then recorded as
-a stop ("stopped", with the outputs of a stopping step), and under MPI a rank that raised
-alone would write those outputs collectively while the others solve the next step: it would
-wait for ever. Inside ``with dd.steps(...) as run:`` the exit sees the exception:
+stores the exception in flight while it finalises the generator). A raise is then taken for a
+stop ("stopped", with the outputs of a stopping step). Under MPI a rank that raised alone
+would write those outputs collectively while the others solve the next step, and wait for
+ever: so, in dd.steps on several ranks, the ranks agree after every hand-over of a step
+whether their callers left the loop (:func:`together`, one allgather of a flag); when only
+some did, they end their run without any collective call, and the others raise
+:class:`LoopLeft` with summary.json "failed". Inside ``with dd.steps(...) as run:`` the exit
+sees the exception itself:
 
 * the body raised (on any rank): the run is abandoned without any collective call
   (``Run.abandon``), then the call's outcome is decided on every rank
@@ -20,12 +24,44 @@ wait for ever. Inside ``with dd.steps(...) as run:`` the exit sees the exception
 from __future__ import annotations
 
 
+class LoopLeft(RuntimeError):
+    """dd.steps under MPI: the loop ended on some ranks (an exception of the loop body, or a
+    break the others did not take) while this rank went on."""
+
+
+def together(run, leaving: bool) -> bool:
+    """After each hand-over of a step (``run.handshake``: dd.steps on several ranks), every
+    rank says whether its caller left the loop there (one allgather of a flag; nothing on one
+    rank or for dd.run). Returns True when the outputs of a stop may be written (every rank
+    leaves, or no handshake). When only some ranks leave: those return False (they write
+    nothing collective and end their run), the others mark summary.json "failed" and raise
+    :class:`LoopLeft`, so that no rank waits for another that will never come."""
+    comm = run.comm
+    if not run.handshake or comm.size == 1:
+        return True
+    left = [rank for rank, flag in enumerate(comm.allgather(bool(leaving))) if flag]
+    if not left or len(left) == comm.size:
+        return True
+    if leaving:
+        return False
+    n = run.stepper.n
+    error = LoopLeft(f"the loop over the steps ended on rank(s) {', '.join(map(str, left))} at "
+                     f"step {n} while the others went on (an exception of its loop body, or a "
+                     "break the others did not take; 'with dd.steps(...) as run:' records the "
+                     "exception itself); the run is stopped without the outputs of a stop")
+    if comm.rank == min(set(range(comm.size)) - set(left)):
+        from damage_dolfinx.runtime.collective import mark
+        mark(run.out, error)
+    raise error
+
+
 class Steps:
     """The steps of one prepared run (``Run.prepare``): iterate over it, or use it as a
     context manager around the loop (see the module's docstring)."""
 
     def __init__(self, run, comm):
         self._run, self._comm = run, comm
+        run.handshake = True
         self._steps = run.steps()
         self._outcome = None
 

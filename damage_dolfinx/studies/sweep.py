@@ -168,6 +168,7 @@ def _check_point(ex, i, values, n, k, T, meshes, together, comm, plot=None):
     (``plot``) that ``plot`` is one of the final scalars its run reports
     (validation_scalars.py). InputError naming the point otherwise; returns the point's mesh
     size (n, h)."""
+    c = None
     try:
         c = ex.configure(n, k, T, None, dict(values))
         size = (c.n, c.h)
@@ -177,11 +178,27 @@ def _check_point(ex, i, values, n, k, T, meshes, together, comm, plot=None):
         if plot is not None and geometry is None:
             geometry = c.make_geometry(comm, *size)
     except InputError as exc:
-        raise InputError(f"point {i} ({_describe(values)}): {exc}") from None
+        raise _point_error(ex, i, values, n, k, T, exc, c is not None, comm) from None
     if plot is not None:  # the first point checked: the scalars its run reports
         from damage_dolfinx.validation_scalars import check_plot
         check_plot(plot, c, geometry, comm)
     return size
+
+
+def _point_error(ex, i, values, n, k, T, exc, in_mesh, comm) -> InputError:
+    """The refusal of point ``i``, named by the point only when its grid values cause it: the
+    same settings without them (the sweep's n, k, T and the example's data) refused alike mean
+    a setting of the whole sweep is wrong (a T below k, too many steps, an n the hole does not
+    fit), which is said without a point. ``in_mesh``: the point's mesh refused it (built again
+    without the grid values; every rank is here alike, as in the point's own check)."""
+    try:
+        c = ex.configure(n, k, T, None, {})
+        if in_mesh:
+            c.make_geometry(comm, c.n, c.h)
+    except InputError as base:
+        if str(base) == str(exc):
+            return InputError(str(exc))
+    return InputError(f"point {i} ({_describe(values)}): {exc}")
 
 
 def _another_sweep(out, mapping, comm):
