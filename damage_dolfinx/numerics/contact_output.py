@@ -66,10 +66,11 @@ def near_contact(form, V, facet_tags):
     msh = V.mesh
     w = ufl.TestFunction(compat.scalar_p1(msh))
     ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
-    marker = compat.create_vector(compat.form(w * ds(GAMMA_C)))
+    on_facets = compat.form(w * ds(GAMMA_C))
+    marker = compat.create_vector(on_facets)
     with marker.localForm() as local:
         local.set(0.0)
-    compat.assemble_vector(marker, compat.form(w * ds(GAMMA_C)))
+    compat.assemble_vector(marker, on_facets)
     marker.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     marker.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
     with marker.localForm() as local:

@@ -129,9 +129,9 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     of the points not yet finished, then stop (the others stay pending). ``plot``: the final
     scalar drawn against the swept parameters in ``sweep.png`` (a name that is not one of the
     final scalars a run of the problem reports is refused before any run, for the package's
-    models; with a model of your own, after the runs: a warning, no plot). ``n``, ``k``, ``T`` apply to
-    every point. ``ranks_per_point``: the size of the groups of ranks that each run one point
-    in parallel (a divisor of the number of ranks; default 1). ``point``: run only this point
+    models; with a model of your own, after the runs: a warning, no plot). ``n``, ``k``, ``T``
+    apply to every point. ``ranks_per_point``: the size of the groups of ranks that each run
+    one point in parallel (a divisor of the number of ranks; default 1). ``point``: run only this point
     (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
     processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
@@ -173,9 +173,7 @@ def _check_point(ex, i, values, n, k, T, meshes, together, comm, plot=None):
         c = ex.configure(n, k, T, None, dict(values))
         size = (c.n, c.h)
         geometry = None
-        if not together and size not in meshes:
-            geometry = c.make_geometry(comm, *size)
-        if plot is not None and geometry is None:
+        if plot is not None or (not together and size not in meshes):
             geometry = c.make_geometry(comm, *size)
     except InputError as exc:
         raise _point_error(ex, i, values, n, k, T, exc, c is not None, comm) from None
