@@ -131,9 +131,9 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     final scalars a run of the problem reports is refused before any run, for the package's
     models; with a model of your own, after the runs: a warning, no plot). ``n``, ``k``, ``T``
     apply to every point. ``ranks_per_point``: the size of the groups of ranks that each run
-    one point in parallel (a divisor of the number of ranks; default 1). ``point``: run only this point
-    (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array; several
-    processes may run points of the same ``out`` at once."""
+    one point in parallel (a divisor of the number of ranks; default 1). ``point``: run only
+    this point (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array;
+    several processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.validation import check_sweep, communicator
     with outcome(communicator("comm", comm)):
