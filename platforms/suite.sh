@@ -28,7 +28,8 @@ for suite in "${suites[@]}"; do
   # test leaves its own): Open MPI 5/6 names them by mpirun's pid, and a new mpirun that gets a
   # reused pid (pid_max 32768) refuses to start ("prte_session_dir failed: Exists"). Only this
   # suite runs in the root (one leg at a time), so none of them belongs to a live job.
-  rm -rf "$root"/tmp/prterun.* "$root"/tmp/prte.* "$root"/tmp/ompi.*
+  find "$root/tmp" -mindepth 1 -maxdepth 1 \( -name 'prterun.*' -o -name 'prte.*' -o -name 'ompi.*' \) \
+    -exec rm -rf {} +
   t0=$SECONDS
   r=0
   in_root "$root" "cd /opt/damage-dolfinx && make setup >/dev/null && .venv/bin/python -c 'import dolfinx; print(\"$suite: DOLFINx\", dolfinx.__version__)' && make test PYTEST_ARGS='$*'" || r=$?
