@@ -13,9 +13,14 @@ from damage_dolfinx.numerics.contact import normal_compliance_term
 from damage_dolfinx.forms.elastic_damage import load
 
 
+def memory_stress(u, E, nu, L_trunc):
+    """Phi_L(B eps(u)), the stress factor of g (cell-wise constant for P1 u on simplices)."""
+    return Phi_L(B(eps(u), E, nu), L_trunc)
+
+
 def memory_integrand(u, zeta, E, nu, L_trunc):
     """g(eps(u), zeta) = zeta Phi_L(B eps(u)) (kernel G = a(t - s) g, Section 1.6)."""
-    return zeta * Phi_L(B(eps(u), E, nu), L_trunc)
+    return zeta * memory_stress(u, E, nu, L_trunc)
 
 
 def total_stress(u, M, E, nu):

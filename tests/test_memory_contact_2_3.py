@@ -140,3 +140,66 @@ def test_split_jacobian_equals_assembly():
     w = ufl.TestFunction(V)
     assert constant_cell_jacobian(ufl.inner(s.u, s.u) * ufl.inner(s.u, w) * ufl.dx
                                   + ufl.inner(s.u, w) * ds(GAMMA_C), s.u) is None
+
+
+def test_split_residual_and_jacobian_key():
+    """The 2.3 residual K u + (M_n, eps(w)) - L_n(w) + Gamma_C term (split_residual.py) equals
+    the assembled one at a state in partial contact with a nonzero memory; the Jacobian key
+    (the assembled Gamma_C Jacobian) is unchanged while the contact set is and changes with it."""
+    from damage_dolfinx import compat
+    from damage_dolfinx.numerics.split_residual import SplitResidual
+    params = ModelParameters(E=100.0, nu=0.3, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,
+                             stop_at_zeta_star=False,
+                             extra={"c_nu": 1e3, "gap": 0.0, "memory_kernel": "constant"})
+    geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 6, 6,
+                    {GAMMA_D: side(1, 1.0), GAMMA_C: side(1, 0.0)})
+    s = ViscoelasticMemoryContact(Problem("2.3", geo, 1.0, k=1.0, params=params, name="split-test"))
+    assert isinstance(s._residual, SplitResidual)
+    rng = np.random.default_rng(3)
+    s.memory.M.x.array[:] = rng.standard_normal(s.memory.M.x.array.size)
+    X = s.u.function_space.tabulate_dof_coordinates()
+    s.u.x.array.reshape(-1, 2)[:, 1] = -0.01 * np.sin(7.0 * X[:, 0])  # contact where < 0
+    s.u.x.array.reshape(-1, 2)[np.isclose(X[:, 1], 1.0)] = 0.0         # the clamped side
+    x = compat.petsc_vec(s.u).copy()
+    b_form, b_split = x.duplicate(), x.duplicate()
+    s._residual.begin()
+    s.mech.form_residual(x, b_form)
+    s._residual(x, b_split)
+    b_split.axpy(-1.0, b_form)
+    assert b_split.norm() <= 1e-13 * b_form.norm()
+    key = s._residual.jacobian_key(x)
+    x.scale(1.5)  # the same contact set
+    s._residual(x, b_split)
+    assert np.array_equal(s._residual.jacobian_key(x), key)
+    x.scale(-1.0)  # the complementary contact set
+    s._residual(x, b_split)
+    assert not np.array_equal(s._residual.jacobian_key(x), key)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_cellwise_memory_integrand_equals_interpolation(dim):
+    """g = zeta Phi_L(B eps(u)) from the stress at one point per cell times zeta's vertex
+    values equals the interpolation of g into DG1 (Phi_L clipping half the components)."""
+    from dolfinx import fem, mesh
+    from damage_dolfinx import compat
+    from damage_dolfinx.forms.viscoelastic_memory import memory_integrand, memory_stress
+    from damage_dolfinx.numerics.memory import CellwiseIntegrand
+    comm = MPI.COMM_WORLD
+    msh = (mesh.create_unit_square(comm, 6, 5) if dim == 2
+           else mesh.create_unit_cube(comm, 3, 3, 2))
+    V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+    G = compat.function_space(msh, "DG", 1, (dim, dim))
+    u, zeta, g, g_ref = fem.Function(V), fem.Function(Z), fem.Function(G), fem.Function(G)
+    rng = np.random.default_rng(1)
+    u.x.array[:] = rng.standard_normal(u.x.array.size)
+    zeta.x.array[:] = rng.uniform(0.01, 1.0, zeta.x.array.size)
+    for f in (u, zeta):
+        f.x.scatter_forward()
+    E, nu, L = 100.0, 0.3, 150.0
+    compat.interpolate(g_ref, compat.expression(memory_integrand(u, zeta, E, nu, None), G))
+    unclipped = g_ref.x.array.copy()
+    compat.interpolate(g_ref, compat.expression(memory_integrand(u, zeta, E, nu, L), G))
+    assert not np.allclose(unclipped, g_ref.x.array)  # Phi_L clips some components
+    CellwiseIntegrand(memory_stress(u, E, nu, L), zeta, G)(g)
+    print("max difference", np.abs(g.x.array - g_ref.x.array).max())
+    assert np.abs(g.x.array - g_ref.x.array).max() <= 1e-14 * np.abs(g_ref.x.array).max()

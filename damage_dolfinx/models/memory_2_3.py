@@ -30,10 +30,10 @@ from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.numerics.damage import DamageStep
-from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_integrand, total_stress
-from damage_dolfinx.numerics.memory import MemoryKernel, MemoryTerm
+from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_stress, total_stress
+from damage_dolfinx.numerics.memory import CellwiseIntegrand, MemoryKernel, MemoryTerm
+from damage_dolfinx.numerics.split_residual import SplitResidual, affine_cell_split
 from damage_dolfinx.parameters import InputError
-from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
 from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
@@ -93,8 +93,9 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         kernel = MemoryKernel(x["memory_kernel"], float(x.get("memory_amplitude", 1.0)),
                               float(x.get("memory_rate", 1.0)))
         self.memory = MemoryTerm(msh, kernel, k, x.get("memory_mode", "auto"))
-        self._g_expr = compat.expression(
-            memory_integrand(self.u, self.zeta, p.E, p.nu, p.L_trunc), self.memory.space)
+        # g = zeta Phi_L(B eps(u)): the stress factor at one point per cell (P1 u), times zeta
+        self._g_expr = CellwiseIntegrand(memory_stress(self.u, p.E, p.nu, p.L_trunc), self.zeta,
+                                         self.memory.space)
 
         # (2.137): nonlinear displacement step
         tags = data.geometry.facet_tags
@@ -105,6 +106,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
                                   self.c_nu, self.gap, self.n_facet, f_B, f_N, ds(GAMMA_N),
                                   ds(GAMMA_C))
         bc = clamped(V, tags, GAMMA_D)
+        self._residual = None  # the split residual of the lagged direct path
         if scalable.iterative(V) and mech_contact_amg():  # 3-D at size: CG + BoomerAMG
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
                                         defaults=mech_contact_amg(),
@@ -115,10 +117,17 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
                 A.setNearNullSpace(modes)
         else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation; the Jacobian
             # is the constant (B eps(du), eps(w)) plus the Gamma_C term, which alone is
-            # assembled per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per step)
+            # assembled per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per step), and only
+            # when its values change (the key); the residual is K u + (M_n, eps(w)) - L_n(w)
+            # + the Gamma_C term, the middle part assembled once per step (split_residual.py)
+            split = affine_cell_split(F, self.u)  # (a, l, r, dr/du): F = a(u) + l_n + r(u)
+            self._residual = SplitResidual(F, self.u, [bc], split)
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
                                         refactor_after_its=MECH_REFACTOR_ITS,
-                                        jacobian_split=constant_cell_jacobian(F, self.u))
+                                        jacobian_split=(split[0], split[3]),
+                                        residual=self._residual,
+                                        jacobian_key=self._residual.jacobian_key)
+            self._residual.check(self.mech.form_residual)
 
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
@@ -138,8 +147,14 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         return {**super().checkpoint_state(), "memory": self.memory.M}
 
     def start(self) -> dict:
-        its = self._timed("mech", self.mech.solve)
+        its = self._timed("mech", self._mech_solve)
         return {"mech_its": its}
+
+    def _mech_solve(self) -> int:
+        """(2.137) by Newton, the step's (M_n, eps(w)) - L_n(w) assembled first."""
+        if self._residual is not None:
+            self._residual.begin()
+        return self.mech.solve()
 
     def scheme(self) -> tuple:
         """The memory M_n first, from g(u_{n-1}, zeta_{n-1}) (2.136), then the damage step (1.5)
@@ -149,7 +164,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
                         partial(self.memory.update, self._g_expr)),
                 SubStep("damage", "linear", damage_prefix, self.damage.solve,      # (1.5)
                         its=("damage_its",)),
-                SubStep("mech", "semismooth", mech_prefix, self.mech.solve,        # (2.137)
+                SubStep("mech", "semismooth", mech_prefix, self._mech_solve,       # (2.137)
                         its=("snes_its",)))
 
     def update_output(self):
