@@ -115,19 +115,19 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
             modes = scalable.rigid_body_modes(V)
             for A in (J, P):
                 A.setNearNullSpace(modes)
-        else:  # 2-D (unchanged) and small 3-D: CG on a lagged factorisation; the Jacobian
-            # is the constant (B eps(du), eps(w)) plus the Gamma_C term, which alone is
-            # assembled per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per step), and only
-            # when its values change (the key); the residual is K u + (M_n, eps(w)) - L_n(w)
-            # + the Gamma_C term, the middle part assembled once per step (split_residual.py)
-            split = affine_cell_split(F, self.u)  # (a, l, r, dr/du): F = a(u) + l_n + r(u)
-            self._residual = SplitResidual(F, self.u, [bc], split)
+        else:  # 2-D and small 3-D: CG on a lagged factorisation; the Jacobian is the
+            # constant K = (B eps(du), eps(w)) plus the Gamma_C term, which alone is assembled
+            # per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per step), and only when its
+            # values change (the key); the residual is assembled once per step, then updated
+            # by K (x - x_0) and the Gamma_C term (split_residual.py)
+            split = affine_cell_split(F, self.u)  # (K, r, dr/du): F = F_cell + r
+            self._residual = SplitResidual(self.u, [bc], split)
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
                                         refactor_after_its=MECH_REFACTOR_ITS,
-                                        jacobian_split=(split[0], split[3]),
+                                        jacobian_split=(split[0], split[2]),
                                         residual=self._residual,
                                         jacobian_key=self._residual.jacobian_key)
-            self._residual.check(self.mech.form_residual)
+            self._residual.attach(self.mech.form_residual)
 
         Q = compat.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
@@ -151,7 +151,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         return {"mech_its": its}
 
     def _mech_solve(self) -> int:
-        """(2.137) by Newton, the step's (M_n, eps(w)) - L_n(w) assembled first."""
+        """(2.137) by Newton from u_{n-1}, whose residual is assembled first."""
         if self._residual is not None:
             self._residual.begin()
         return self.mech.solve()

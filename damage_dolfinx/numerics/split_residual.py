@@ -1,28 +1,33 @@
-"""An algebraic Newton residual for a residual whose domain part is affine in u with fixed
-coefficients (2.3's (2.137)):
+"""A Newton residual without a cell assembly per evaluation, for a residual whose cell part is
+affine in u with fixed coefficients (2.3's (2.137)):
 
-    F(u; w) = a(u, w) + l_n(w) + r(u; w),
+    F(u; w) = F_cell(u; w) + r(u; w),   F_cell(x) = F_cell(x_0) + K (x - x_0),
 
-a(u, w) the cell integrals' part linear in u (no Function in da/du: K, assembled once, with
-the Dirichlet rows of the identity), l_n(w) = F_cell(0; w) the cell integrals at u = 0 (the
-memory (M_n, eps(w)) and the body force: they change once per time step, assembled by
-:meth:`SplitResidual.begin`), r(u; w) the other integrals (the Gamma_C contact term and the
-traction: a boundary assembly per call). A residual evaluation is then K x + l_n + r(x) with
-x - g on the Dirichlet rows, as :func:`callbacks.form_callbacks` assembles it, instead of an
-assembly over every cell.
+K = dF_cell/du (no Function in it: assembled once, Dirichlet rows of the identity), r the
+other integrals (the Gamma_C contact term and the traction: a boundary assembly). At the start
+of a solve (:meth:`SplitResidual.begin`) the residual is assembled once at the starting point
+x_0 as :func:`callbacks.form_callbacks` assembles it, F(x_0), with r(x_0); every evaluation is
+then
+
+    F(x) = (r(x) - r(x_0)) + F(x_0) + K (x - x_0),   x - g (= x) on the Dirichlet rows,
+
+a boundary assembly and a product with K instead of an assembly over every cell. The first
+evaluation, at x_0, is F(x_0) bit for bit, so Newton's first step is the assembled one; the
+later ones differ from the assembly by round-off relative to the increment x - x_0, not to u
+(an algebraic K x + F_cell(0) would cancel the elastic stress against the memory term and
+lose digits: the 2.3 memory modes then agreed to 8e-12 instead of 8e-13).
 
 The Jacobian is K + dr/du, so the assembled values of dr/du (a boundary assembly) are an exact
 key of the Jacobian (:meth:`SplitResidual.jacobian_key`, for NonlinearSolver's
 ``jacobian_key``): while they are unchanged (the same contact set) the Jacobian is not
 re-assembled, and it is bit for bit the one it would be.
 
-Homogeneous Dirichlet conditions only (g = 0, the clamped side); the split is checked once
-against the assembled residual at a random u (relative 1e-12).
+Homogeneous Dirichlet conditions only (g = 0, the clamped side, which the iterates keep); the
+split is checked against the assembled residual at a random u when attached (relative 1e-12).
 """
 from __future__ import annotations
 
 import numpy as np
-import ufl
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
@@ -33,60 +38,65 @@ CHECK_RTOL = 1e-12
 
 
 def affine_cell_split(F, u):
-    """(a, l, r, dr) with F = a(u) + l + r(u) as in the module docstring: a = J_cell (bilinear,
-    no Function), l = the cell integrals at u = 0, r = the other integrals, dr = dr/du; None
-    when the cell part of dF/du depends on a Function or nothing else varies."""
+    """(K, r, dr/du) forms with F = F_cell + r as in the module docstring: K = dF_cell/du (no
+    Function), r = the non-cell integrals of F; None when K depends on a Function or F has
+    no other integral."""
     split = constant_cell_jacobian(F, u)
     if split is None:
         return None
-    J_cell, J_rest = split
-    cell = [i for i in F.integrals() if i.integral_type() == "cell"]
+    import ufl
     rest = [i for i in F.integrals() if i.integral_type() != "cell"]
-    zero = ufl.replace(ufl.Form(cell), {u: ufl.zero(*u.ufl_shape)}) if cell else None
-    return J_cell, zero, ufl.Form(rest), J_rest
+    return split[0], ufl.Form(rest), split[1]
 
 
 class SplitResidual:
-    """The residual callback (x, b) of NonlinearSolver for F = a(u) + l_n + r(u); call
-    :meth:`begin` at the start of each solve (after l_n's coefficients, e.g. M_n and the
-    load's time, are set)."""
+    """The residual callback (x, b) of NonlinearSolver for F = F_cell + r (module docstring).
+    :meth:`attach` it to the solver's assembled residual once, then call :meth:`begin` at the
+    start of each solve, with u at the starting point."""
 
-    def __init__(self, F, u, bcs, split=None):
-        J_cell, F_zero, F_rest, J_rest = split or affine_cell_split(F, u)
+    def __init__(self, u, bcs, split):
+        J_cell, F_rest, J_rest = split
         self.u, self.bcs = u, list(bcs)
         self.u_vec = compat.petsc_vec(u)
         a = compat.form(J_cell)
         self.K = compat.create_matrix(a)
         compat.assemble_matrix(self.K, a, self.bcs)  # Dirichlet rows: identity
         self.K.assemble()
-        self.zero_form = compat.form(F_zero) if F_zero is not None else None
         self.rest_form = compat.form(F_rest)
-        self.l = compat.create_vector(self.rest_form)
-        self.l.set(0.0)
+        self.F0 = compat.create_vector(self.rest_form)
+        self.r0, self.x0, self.dx = self.F0.duplicate(), self.F0.duplicate(), self.F0.duplicate()
         self.key_form = compat.form(J_rest)
         self.dr = compat.create_matrix(self.key_form)
-        self._check_homogeneous()
+        self.form_residual = None
+        probe = self.K.createVecLeft()
+        probe.set(0.0)
+        compat.set_bc(probe, self.bcs)  # the Dirichlet rows <- g
+        if probe.norm() != 0.0:
+            raise ValueError("SplitResidual: Dirichlet values must be zero")
 
     def begin(self):
-        """Assemble l_n, the cell integrals at u = 0, for this solve."""
-        if self.zero_form is None:
-            return
-        with self.l.localForm() as ll:
-            ll.set(0.0)
-        compat.assemble_vector(self.l, self.zero_form)
-        self.l.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        """F(x_0) and r(x_0) at the starting point x_0 = u of this solve."""
+        self.u_vec.copy(self.x0)
+        self.form_residual(self.x0, self.F0)
+        self._assemble_rest(self.r0)
 
-    def __call__(self, x, b):
-        """b = K x + l_n + r(x), x - g (= x) on the Dirichlet rows; x is copied into u."""
-        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
-        x.copy(self.u_vec)
-        self.u.x.scatter_forward()
+    def _assemble_rest(self, b):
         with b.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(b, self.rest_form)
         b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
-        self.K.multAdd(x, b, b)
-        b.axpy(1.0, self.l)
+
+    def __call__(self, x, b):
+        """b = (r(x) - r(x_0)) + F(x_0) + K (x - x_0), x on the Dirichlet rows; x is copied
+        into u."""
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        x.copy(self.u_vec)
+        self.u.x.scatter_forward()
+        self._assemble_rest(b)
+        b.axpy(-1.0, self.r0)
+        b.axpy(1.0, self.F0)
+        self.dx.waxpy(-1.0, self.x0, x)
+        self.K.multAdd(self.dx, b, b)
         compat.set_bc(b, self.bcs, x, -1.0)
 
     def jacobian_key(self, x) -> np.ndarray:
@@ -97,16 +107,11 @@ class SplitResidual:
         self.dr.assemble()
         return self.dr.getValuesCSR()[2].copy()
 
-    def _check_homogeneous(self):
-        probe = self.K.createVecLeft()
-        probe.set(0.0)
-        compat.set_bc(probe, self.bcs)  # the Dirichlet rows <- g
-        if probe.norm() != 0.0:
-            raise ValueError("SplitResidual: Dirichlet values must be zero")
-
-    def check(self, form_residual) -> float:
-        """The relative difference to ``form_residual`` (form_callbacks' assembly) at a random u
-        vanishing on the Dirichlet dofs (u restored); raises beyond CHECK_RTOL."""
+    def attach(self, form_residual) -> float:
+        """Use ``form_residual`` (form_callbacks' assembly) for F(x_0); returns the relative
+        difference of the two at a random x vanishing on the Dirichlet dofs, from x_0 = the
+        current u (u restored), and raises beyond CHECK_RTOL."""
+        self.form_residual = form_residual
         saved = self.u.x.array.copy()
         x = self.u_vec.duplicate()
         x.setRandom(PETSc.Random().create(x.getComm()))
