@@ -34,14 +34,15 @@ from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memo
 from damage_dolfinx.numerics.memory import CellwiseIntegrand, MemoryKernel, MemoryTerm
 from damage_dolfinx.numerics.split_residual import SplitResidual, affine_cell_split
 from damage_dolfinx.parameters import InputError
-from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver
+from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver, lagged_direct
 from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
 
 
-#: Krylov iterations above which the lagged Jacobian factorisation is rebuilt
+#: Krylov iterations above which the lagged Jacobian factorisation is rebuilt (with a Krylov
+#: -mech_ksp_type; the default applies the factorisation once, mech_direct)
 MECH_REFACTOR_ITS = 10
 
 
@@ -53,6 +54,16 @@ def mech_contact_amg():
     (2.3-ex1-3d, n = 10 and 20), with SOR smoothing a failed level solve at n = 20; BoomerAMG
     took 8-14 CG iterations per Newton step at n = 10 and 20."""
     return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
+
+
+def mech_direct(comm) -> dict:
+    """Newton defaults of the displacement step below the AMG size: the lagged direct solve's
+    factorisation (PETSc's Cholesky serially, MUMPS in parallel) applied once (``preonly``).
+    The factorisation is rebuilt whenever the Jacobian changes (a new contact set), so it is
+    the Jacobian's own and Newton is exact; CG on it (the lagged default, ``-mech_ksp_type
+    cg``) converged in one iteration at the cost of a second triangular solve per Newton
+    step (2.3-ex1, ex3: the same factorisations, 165 against 116 solves on ex3)."""
+    return {**NEWTON, **lagged_direct(comm), "ksp_type": "preonly"}
 
 
 class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
@@ -115,18 +126,21 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
             modes = scalable.rigid_body_modes(V)
             for A in (J, P):
                 A.setNearNullSpace(modes)
-        else:  # 2-D and small 3-D: CG on a lagged factorisation; the Jacobian is the
-            # constant K = (B eps(du), eps(w)) plus the Gamma_C term, which alone is assembled
-            # per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per step), and only when its
-            # values change (the key); the residual is assembled once per step, then updated
-            # by K (x - x_0) and the Gamma_C term (split_residual.py)
+        else:  # 2-D and small 3-D: a factorisation kept while the Jacobian is unchanged;
+            # the Jacobian is the constant K = (B eps(du), eps(w)) plus the Gamma_C term,
+            # which alone is assembled per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per
+            # step), and only when its values change (the key); the residual is assembled
+            # once per step, then updated by K (x - x_0) and the Gamma_C term
+            # (split_residual.py)
             split = affine_cell_split(F, self.u)  # (K, r, dr/du): F = F_cell + r
             self._residual = SplitResidual(self.u, [bc], split)
             self.mech = NonlinearSolver(F, self.u, [bc], mech_prefix, self.context,
+                                        defaults=mech_direct(msh.comm),
                                         refactor_after_its=MECH_REFACTOR_ITS,
                                         jacobian_split=(split[0], split[2]),
                                         residual=self._residual,
                                         jacobian_key=self._residual.jacobian_key)
+            self.mech.jacobian_change_tol = 0.0  # refactorised at any change: exact Newton
             self._residual.attach(self.mech.form_residual)
 
         Q = compat.scalar_dg0(msh)
