@@ -6,8 +6,10 @@ and damage (PDE form, variant A), scheme (2.136)-(2.137).
           M_n = sum_{j=1..n} k G(t_n - t_{j-1}, eps(u_{j-1}), zeta_{j-1})                    (2.136)
           (B eps(u_n) + M_n, eps(w)) + (p_nu(u_n.nu - gap), w.nu)_{Gamma_C} = L_n(w)         (2.137)
 
-p_nu(r) = c_nu r_+ (semismooth Newton, SNES prefix ``mech_``); damage PDE step prefix
-``damage_`` (matrix factorised once). The dimension comes from the mesh: on a 3-D mesh
+p_nu(r) = c_nu r_+ (semismooth Newton, SNES prefix ``mech_``: the residual assembled once per
+step at u_{n-1}, then F(u_{n-1}) + K (u - u_{n-1}) + the change of the Gamma_C term, K the
+constant (B eps(du), eps(w)); the Jacobian K + the Gamma_C term factorised again only when the
+latter changes); damage PDE step prefix ``damage_`` (matrix factorised once). The dimension comes from the mesh: on a 3-D mesh
 B is 3-D Hooke, M_n a 3x3 tensor, Gamma_C any plane or curved face; from
 ``scalable.DIRECT_MAX_DOFS_3D`` unknowns on, Newton's linear systems are solved by CG +
 BoomerAMG (``mech_contact_amg``; the AMG set-up lagged like the factorisation in 2-D) and
