@@ -10,8 +10,8 @@ in the tests:
 * ``sum``       (any a): the plain sum over the stored history, O(n) work and storage per step.
 
 M and g live in a DG1 tensor space (exact: zeta is P1 and Phi_L(B eps(u)) cell-wise constant).
-:class:`CellwiseIntegrand` writes g = zeta S from S = Phi_L(B eps(u)) interpolated at one
-point per cell (DG0 tensors) and the vertex values of zeta: the same values as the interpolation
+:class:`CellwiseIntegrand` writes g = zeta S from S = Phi_L(B eps(u)) evaluated at one
+point per cell and the vertex values of zeta: the same values as the interpolation
 of zeta S into DG1 (to round-off: tests/test_memory_contact_2_3.py), at a third of its
 points.
 """
@@ -81,36 +81,32 @@ class MemoryTerm:
 
 class CellwiseIntegrand:
     """g = zeta S in a DG1 tensor space, S a cell-wise constant tensor expression (e.g.
-    Phi_L(B eps(u)) with P1 u on simplices): S is interpolated into DG0 tensors (one point per
-    cell), then each cell's DG1 block at vertex i is zeta(vertex i) S. Call with the DG1
+    Phi_L(B eps(u)) with P1 u on simplices): S is evaluated at one point per cell (the DG0
+    interpolation point, by the compiled expression's ``eval``: no interpolation into a
+    Function), then each cell's DG1 block at vertex i is zeta(vertex i) S. Call with the DG1
     Function g to fill."""
 
     def __init__(self, S_expr, zeta: fem.Function, g_space):
         msh = zeta.function_space.mesh
         d = msh.topology.dim
-        self.T = compat.function_space(msh, "DG", 0, (d, d))
-        self.S = fem.Function(self.T)
-        self.expr = compat.expression(S_expr, self.T)
-        self.zeta, self.comps = zeta, d * d
-        q = compat.cell_dofs(self.T)[:, 0]          # the cell's DG0 tensor block
-        zc = compat.cell_dofs(zeta.function_space)  # (cells, d + 1) vertex dofs of zeta
-        gc = compat.cell_dofs(g_space)              # (cells, d + 1) DG1 tensor blocks
+        self.mesh, self.comps = msh, d * d
+        self.expr = compat.expression(S_expr, compat.function_space(msh, "DG", 0, (d, d)))
+        self.zeta = zeta
+        zc = compat.cell_dofs(zeta.function_space)  # (owned cells, d + 1) vertex dofs of zeta
+        gc = compat.cell_dofs(g_space)              # (owned cells, d + 1) DG1 tensor blocks
         if gc.shape != zc.shape or g_space.dofmap.index_map_bs != self.comps:
             raise ValueError("CellwiseIntegrand: g must live in the DG1 tensor space")
-        # the usual numbering (cell c holds DG0 block c and DG1 blocks (d+1)c ...): views and
-        # products in place instead of gathers and a scatter
-        self._q = None if np.array_equal(q, np.arange(q.size)) else q
+        self.cells = np.arange(zc.shape[0], dtype=np.int32)
+        # the usual numbering (cell c holds the DG1 blocks (d+1)c ...): the product in place
         self._gc = None if np.array_equal(gc.ravel(), np.arange(gc.size)) else gc.ravel()
         self._zc, self._z = zc, np.empty(zc.shape)
 
     def __call__(self, g: fem.Function):
-        compat.interpolate(self.S, self.expr)
-        nc, c = self._zc.shape[0], self.comps
-        S = self.S.x.array.reshape(-1, c)
-        S = S[:nc] if self._q is None else S[self._q]
+        c = self.comps
+        S = compat.eval_expression(self.expr, self.mesh, self.cells).reshape(-1, c)
         z = np.take(self.zeta.x.array, self._zc, out=self._z)  # (cells, d + 1)
-        values = g.x.array.reshape(-1, c)
         # g[cell, vertex, :] = z[cell, vertex] S[cell, :] (einsum: 2.4x the broadcast product)
+        values = g.x.array.reshape(-1, c)
         if self._gc is None:
             np.einsum("ij,ik->ijk", z, S, out=values[:z.size].reshape(z.shape + (c,)))
         else:
