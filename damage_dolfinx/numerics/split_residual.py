@@ -19,7 +19,7 @@ lose digits: the 2.3 memory modes then agreed to 8e-12 instead of 8e-13).
 
 The Jacobian is K + dr/du, so the assembled values of dr/du (a boundary assembly) are an exact
 key of the Jacobian (:meth:`SplitResidual.jacobian_key`, for NonlinearSolver's
-``jacobian_key``): while they are unchanged (the same contact set) the Jacobian is not
+``jacobian_key``: a version raised at each change of the values): while they are unchanged (the same contact set) the Jacobian is not
 re-assembled, and it is bit for bit the one it would be.
 
 Homogeneous Dirichlet conditions only (g = 0, the clamped side, which the iterates keep); the
@@ -67,6 +67,7 @@ class SplitResidual:
         self.r0, self.x0, self.dx = self.F0.duplicate(), self.F0.duplicate(), self.F0.duplicate()
         self.key_form = compat.form(J_rest)
         self.dr = compat.create_matrix(self.key_form)
+        self._dr_last, self._version = None, 0
         self.form_residual = None
         probe = self.K.createVecLeft()
         probe.set(0.0)
@@ -100,12 +101,19 @@ class SplitResidual:
         compat.set_bc(b, self.bcs, x, -1.0)
 
     def jacobian_key(self, x) -> np.ndarray:
-        """The assembled values of dr/du at u (= x, set by the residual just evaluated at x):
-        K + dr/du is the Jacobian, so equal keys mean an equal Jacobian."""
+        """A version number of the assembled values of dr/du at u (= x, set by the residual
+        just evaluated at x), raised whenever they differ bit for bit from those of the
+        previous call (PETSc's MatEqual: O(nonzeros), collective); K + dr/du is the Jacobian,
+        so an unchanged version means an unchanged Jacobian."""
         self.dr.zeroEntries()
         compat.assemble_matrix(self.dr, self.key_form, [])
         self.dr.assemble()
-        return self.dr.getValuesCSR()[2].copy()
+        if self._dr_last is None:
+            self._dr_last = self.dr.duplicate(copy=True)
+        elif not self.dr.equal(self._dr_last):
+            self.dr.copy(self._dr_last, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            self._version += 1
+        return np.array([self._version])
 
     def attach(self, form_residual) -> float:
         """Use ``form_residual`` (form_callbacks' assembly) for F(x_0); returns the relative
