@@ -229,19 +229,27 @@ class ContactOutput:
         b.destroy()
         return out
 
+    def _owned_nodes(self):
+        """(u, v or None) at the owned contact nodes, (nodes, dim), from views of the owned
+        values taken once."""
+        if not hasattr(self, "_views"):
+            n = self.V.dofmap.index_map.size_local * self.dim
+            self._views = [f.x.array[:n].reshape(-1, self.dim) if f is not None else None
+                           for f in (self.u, self.slip_rate)]
+        return [None if a is None else a[self.nodes] for a in self._views]
+
     def scalars(self) -> dict:
         F, p, F_tau = self._nodal(tangential=self.slip_rate is not None)
-        m, d = self._m_nodes, self.dim
-        owned = self.V.dofmap.index_map.size_local
-        un = np.einsum("ij,ij->i", self.u.x.array[:owned * d].reshape(-1, d)[self.nodes], self.nu)
+        m, d, nu = self._m_nodes, self.dim, self.nu
+        u, v = self._owned_nodes()
+        un = np.einsum("ij,ij->i", u, nu)
         if self.compliance:
             in_contact, penetration = p > 0, np.maximum(un - self.gap, 0.0)
         else:
             in_contact, penetration = None, np.abs(un)
         sums = [np.dot(p, m), *F.sum(axis=0), np.sum(m[in_contact]) if self.compliance else 0.0]
-        if self.slip_rate is not None:
-            v = self.slip_rate.x.array[:owned * d].reshape(-1, d)[self.nodes]
-            v_tau = v - np.einsum("ij,ij->i", v, self.nu)[:, None] * self.nu
+        if v is not None:
+            v_tau = v - np.einsum("ij,ij->i", v, nu)[:, None] * nu
             sliding = np.sqrt(np.einsum("ij,ij->i", v_tau, v_tau)) > self.eps_slip
             if d == 2:
                 sums += [np.sum(F_tau * self._tau), np.sum(m[sliding])]
@@ -253,7 +261,7 @@ class ContactOutput:
         out = {"contact_normal_force": sums[0], f"contact_{self._size}": size,
                "contact_penetration": peak,
                **{f"contact_force_{c}": sums[1 + i] for i, c in enumerate("xyz"[:d])}}
-        if self.slip_rate is not None:
+        if v is not None:
             friction = sums[d + 2] if d == 2 else float(np.linalg.norm(sums[d + 2:2 * d + 2]))
             out.update({"friction_force": float(friction), f"slip_{self._size}": sums[-1]})
         return {key: float(value) for key, value in out.items()}

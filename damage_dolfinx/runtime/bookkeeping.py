@@ -15,6 +15,9 @@
   ||sigma_n||_Q 0.8 -> 0.05 ms).
 * :func:`local_dot`: x . y of the owned entries of two PETSc vectors, without the reduction of
   ``Vec.dot`` (the reductions are then gathered into one).
+* :class:`FieldNorms`: the norm operators of a model together with the owned views of its
+  fields, looked up once: a history row then costs the two matrix products, three dot
+  products and the extrema of zeta, and no lookup.
 """
 from __future__ import annotations
 
@@ -129,3 +132,50 @@ class PiecewiseConstantNorm:
     def local(self) -> float:
         values = self.f.x.array[:self.weights.size]
         return float(np.dot(self.weights, values * values))
+
+
+class FieldNorms:
+    """This rank's parts of the base scalars of a model with a P1 vector field u and a P1
+    scalar field zeta: u^T M u = ||u||_L2^2, u^T K_eps u = ||eps(u)||_L2^2 and m . zeta = int zeta
+    (:func:`norm_operators`), and min/max zeta over the owned dofs. The owned value arrays are
+    views of the Functions' arrays (valid for the Functions' lifetime), taken once."""
+
+    def __init__(self, u, zeta):
+        from damage_dolfinx import compat
+        V, Z = u.function_space, zeta.function_space
+        self.M, self.K, m, self.area, self.y = norm_operators(V, Z)
+        self.m = m.getArray(readonly=True).copy()
+        self.u_vec = compat.petsc_vec(u)
+        self.u = u.x.array[:V.dofmap.index_map.size_local * V.dofmap.index_map_bs]
+        self.zeta = zeta.x.array[:Z.dofmap.index_map.size_local]
+        self.y, self.y_array = self.work_vector()
+
+    def work_vector(self) -> tuple:
+        """(a PETSc vector of M's rows, its values as a NumPy array): the vector is made on the
+        array, so that products written into it are read without VecGetArray."""
+        (local, size), _ = self.M.getSizes()
+        array = np.zeros(local)
+        vec = PETSc.Vec().createWithArray(array, size=(local, size), bsize=self.M.getBlockSize(),
+                                          comm=self.M.getComm())
+        return vec, array
+
+    def mass(self, x: PETSc.Vec, x_owned: np.ndarray, out: PETSc.Vec,
+             out_owned: np.ndarray) -> float:
+        """x^T M x (this rank's part), M x left in ``out`` (``*_owned``: the owned views)."""
+        self.M.mult(x, out)
+        return float(np.dot(x_owned, out_owned))
+
+    def u_parts(self) -> list:
+        """[u^T M u, u^T K_eps u] (this rank's parts)."""
+        y, y_owned, u, u_owned = self.y, self.y_array, self.u_vec, self.u
+        self.M.mult(u, y)
+        mass = float(np.dot(u_owned, y_owned))
+        self.K.mult(u, y)
+        return [mass, float(np.dot(u_owned, y_owned))]
+
+    def zeta_parts(self) -> tuple:
+        """(m . zeta, min zeta, max zeta) over the owned dofs (+inf / -inf where none)."""
+        z = self.zeta
+        if not z.size:
+            return 0.0, np.inf, -np.inf
+        return float(np.dot(self.m, z)), float(z.min()), float(z.max())
