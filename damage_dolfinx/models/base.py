@@ -191,11 +191,19 @@ class Model:
     def restore(self, n: int):
         """Continue from time level n after checkpoint.load() has set checkpoint_state()."""
         self._set_time(n)
+        self._forget_norms()
+
+    def _forget_norms(self):
+        """The products the scalars carry from step to step start afresh (a loaded state)."""
+        norms = getattr(self, "_field_norms", None)
+        if norms is not None:
+            norms.forget()
 
     # -- time loop interface
     def initialize(self) -> dict:
         """t = 0: zeta_0 (u_0 = v_0 = 0, the Functions' initial value), then :meth:`start`."""
         self._set_time(0)
+        self._forget_norms()
         self.initial_damage()
         self.zeta_old.x.array[:] = self.zeta.x.array
         return self.start()

@@ -192,21 +192,8 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         at t = 0 or after a step without scalars). Equal to the direct products to round-off
         (relative 1e-16 per step)."""
         norms = self.field_norms()
-        if not hasattr(self, "_Mu"):
-            (self._Mu, self._Mu_owned), (self._Mv, self._Mv_owned) = \
-                norms.work_vector(), norms.work_vector()
-            self._v_vec = compat.petsc_vec(self.v)
-            self._v_owned = self.v.x.array[:norms.u.size]
-        Mu, Mv, u = self._Mu, self._Mv, norms.u_vec
-        v_sq = norms.mass(self._v_vec, self._v_owned, Mv, self._Mv_owned)
-        if self._Mu_at == self.n - 1:
-            Mu.axpy(self.k, Mv)  # M u_n = M u_{n-1} + k M v_n  (3.51)
-        elif self._Mu_at != self.n:
-            norms.M.mult(u, Mu)
-        self._Mu_at = self.n
-        norms.K.mult(u, norms.y)
+        u_sq, eps_sq, v_sq = norms.carried_parts(self.v, self.n, self.k)  # (3.51)
         values = norms.u
-        u_sq, eps_sq = float(np.dot(values, self._Mu_owned)), float(np.dot(values, norms.y_array))
         zeta_integral, lo, hi = norms.zeta_parts()
         d = self.mesh.topology.dim
         nodes = values.reshape(-1, d)
@@ -218,14 +205,6 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
                 "zeta_min": -neg_min, "zeta_max": zeta_max,
                 "zeta_mean": float(zeta_integral / norms.area), "v_L2": float(np.sqrt(abs(v_sq))),
                 "u_max": float(np.sqrt(u_max_sq)), "penetration_rms": self.penetration_rms()}
-
-    def restore(self, n: int):
-        super().restore(n)
-        self._Mu_at = None  # M u from the loaded u
-
-    def initialize(self) -> dict:
-        self._Mu_at = None
-        return super().initialize()
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations if self.damage else 0,
