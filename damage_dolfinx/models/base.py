@@ -354,9 +354,6 @@ class Model:
             norms = self._field_norms = bookkeeping.FieldNorms(self.u, self.zeta)
         return norms
 
-    def _assemble_norm_operators(self):
-        return bookkeeping.norm_operators(self.u.function_space, self.zeta.function_space)
-
     # -- contact
     def contact_pressure(self):
         """The normal contact pressure on Gamma_C as a UFL expression of the live Functions

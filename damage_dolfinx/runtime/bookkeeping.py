@@ -13,11 +13,10 @@
 * :class:`PiecewiseConstantNorm`: ||f||_L2^2 of a DG0 Function (any value shape) as w . f^2,
   w_j = int phi_j dx assembled once: no form assembly per step (2.4 Ex. 1 at n = 128:
   ||sigma_n||_Q 0.8 -> 0.05 ms).
-* :func:`local_dot`: x . y of the owned entries of two PETSc vectors, without the reduction of
-  ``Vec.dot`` (the reductions are then gathered into one).
 * :class:`FieldNorms`: the norm operators of a model together with the owned views of its
   fields, looked up once: a history row then costs the two matrix products, three dot
-  products and the extrema of zeta, and no lookup.
+  products and the extrema of zeta, and no lookup; ``carried_parts`` adds ||v||_L2 without a
+  third product where u_n = u_{n-1} + k v_n (M u_n = M u_{n-1} + k M v_n).
 """
 from __future__ import annotations
 
@@ -99,11 +98,6 @@ def sums_and_maxima(comm, sums=(), maxima=()) -> tuple[list, list]:
         comm.Allreduce(MPI.IN_PLACE, [buf, MPI.DOUBLE], op=_SUM_THEN_MAX[0])
     k = len(sums)
     return [float(x) for x in buf[1:1 + k]], [float(x) for x in buf[1 + k:]]
-
-
-def local_dot(x: PETSc.Vec, y: PETSc.Vec) -> float:
-    """x . y over this rank's owned entries (add over ranks to get the dot product)."""
-    return float(np.dot(x.getArray(readonly=True), y.getArray(readonly=True)))
 
 
 class PiecewiseConstantNorm:
