@@ -1,9 +1,10 @@
 """The cost of a step's history scalars: the products and extrema behind ||u||_L2,
 ||eps(u)||_L2, ||v||_L2, min/max zeta and max |u| (history.csv, summary.json), taken every step.
 
-* :func:`norm_matrix`: the norm matrices of vector fields in block (BAIJ) storage, one column
-  index per d x d block: the product reads a quarter less memory (3.1 Ex. 1 at n = 128:
-  0.17 -> 0.13 ms per product, the same values to rounding).
+* :func:`norm_matrix`: the norm matrices of vector fields in symmetric block (SBAIJ) storage,
+  one column index per d x d block of the upper triangle: the product reads about half the
+  memory of AIJ (3.1 Ex. 1 at n = 128, in the loop: 0.36 ms per product with BAIJ, about
+  0.3 with SBAIJ; the same values to rounding).
 * :func:`norm_operators`: those matrices and the integration vector of a model, assembled once.
 * :func:`extrema`: several minima and maxima of owned arrays in one Allreduce (min a = -max -a).
 * :func:`max_node_norm`: max over the nodes of |u(x_i)| from the squared components, without
@@ -26,14 +27,18 @@ from petsc4py import PETSc
 
 
 def norm_matrix(a_form, block_size: int) -> PETSc.Mat:
-    """The assembled matrix of ``a_form`` (no boundary conditions), in block storage (BAIJ)
-    when ``block_size`` > 1. Assembled into BAIJ directly: MatConvert from AIJ takes 0.8 s at
-    33k dofs where the assembly takes 0.01 s."""
+    """The assembled matrix of ``a_form`` (symmetric, no boundary conditions), in symmetric
+    block storage (SBAIJ: the upper triangle of d x d blocks) when ``block_size`` > 1.
+    Assembled into BAIJ directly (MatConvert from AIJ takes 0.8 s at 33k dofs where the
+    assembly takes 0.01 s), then converted to SBAIJ (1 ms): the product reads about half the
+    matrix. In a run's loop, where the solves have just evicted the matrices from the caches,
+    that is what a product costs (3.1 Ex. 1 at n = 128: a history row 1.76 -> 1.64 ms, two
+    products; in isolation, with warm caches, SBAIJ is no faster)."""
     from damage_dolfinx import compat
     A = compat.create_matrix(a_form, "baij" if block_size > 1 else None)
     compat.assemble_matrix(A, a_form, [])
     A.assemble()
-    return A
+    return A.convert("sbaij") if block_size > 1 else A
 
 
 def norm_operators(V, Z) -> tuple:
