@@ -71,6 +71,10 @@ def test_memory_mode_must_match_kernel(tmp_path):
 def test_example1_serial_equals_two_ranks(tmp_path):
     serial_and_two_ranks(tmp_path, ["run", "2.3-ex1", "--n", "8", "--k", "0.05", "--no-figures",
                                     "--quiet"])
+    serial, parallel = history(tmp_path / "s"), history(tmp_path / "p")
+    assert serial.keys() == parallel.keys()
+    for t, row in serial.items():  # ||sigma_n||_L2, summed per cell on each rank's cells
+        assert abs(float(parallel[t]["stress_L2"]) / float(row["stress_L2"]) - 1) < 1e-8, t
 
 
 def history(folder):
@@ -206,3 +210,24 @@ def test_cellwise_memory_integrand_equals_interpolation(dim):
     CellwiseIntegrand(memory_stress(u, E, nu, L), zeta, G)(g)
     print("max difference", np.abs(g.x.array - g_ref.x.array).max())
     assert np.abs(g.x.array - g_ref.x.array).max() <= 1e-14 * np.abs(g_ref.x.array).max()
+
+
+@pytest.mark.parametrize("example, n", [("2.3-ex1", 8), ("2.3-ex1-3d", 3)])
+def test_stress_norm_per_cell_equals_assembly(tmp_path, example, n):
+    """||sigma_n||_L2^2 summed per cell in NumPy (bookkeeping.AffineStressNorm: B eps(u_n)
+    constant and M_n linear on each simplex) equals the assembled form after a few steps
+    (nonzero memory), on every rank count."""
+    import damage_dolfinx as dd
+    from damage_dolfinx import compat
+    seen = 0
+    with dd.steps(example, tmp_path / "o", n=n, k=0.05, T=0.2, progress=False,
+                  figures=False) as run:
+        for step in run:
+            model = step.model
+            assert model._stress_norm is not None
+            cellwise = model.comm.allreduce(model._stress_norm.local())
+            assembled = compat.assemble_scalar(model._stress_sq, model.comm)
+            print(step.n, cellwise, assembled)
+            assert abs(cellwise - assembled) <= 1e-13 * assembled
+            seen += step.n > 0 and np.abs(model.memory.M.x.array).max() > 0
+    assert seen >= 3

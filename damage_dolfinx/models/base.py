@@ -338,14 +338,19 @@ class Model:
         """||u||_L2, ||eps(u)||_L2, min/max/mean zeta (the summary.json 'final' block), from
         matrices assembled once: u^T M u, u^T K_eps u and m . zeta with m_i = int phi_i (exact
         for P1 fields; no assembly per step), in one reduction."""
+        return self.base_scalars()[0]
+
+    def base_scalars(self, sums=()) -> tuple:
+        """(the scalars of :meth:`scalars`, the sums over ranks of this rank's values ``sums``),
+        all in the same reduction."""
         norms = self.field_norms()
         parts = norms.u_parts()
         zeta_integral, lo, hi = norms.zeta_parts()
-        (u_L2_sq, eps_sq, zeta_integral), (neg_min, zeta_max) = \
-            bookkeeping.sums_and_maxima(self.comm, parts + [zeta_integral], [-lo, hi])
+        (u_L2_sq, eps_sq, zeta_integral, *totals), (neg_min, zeta_max) = \
+            bookkeeping.sums_and_maxima(self.comm, parts + [zeta_integral, *sums], [-lo, hi])
         return {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
                 "zeta_min": -neg_min, "zeta_max": zeta_max,
-                "zeta_mean": float(zeta_integral / norms.area)}
+                "zeta_mean": float(zeta_integral / norms.area)}, totals
 
     def field_norms(self) -> bookkeeping.FieldNorms:
         """The norm operators of u and zeta with their owned views (built at the first call)."""

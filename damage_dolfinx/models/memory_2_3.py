@@ -30,7 +30,7 @@ from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx import compat
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.numerics.constitutive import B_coefficients, eps, von_mises
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_stress, total_stress
 from damage_dolfinx.numerics.memory import CellwiseIntegrand, MemoryKernel, MemoryTerm
@@ -41,6 +41,7 @@ from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
 from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.runtime import bookkeeping
 
 
 #: Krylov iterations above which the lagged Jacobian factorisation is rebuilt (with a Krylov
@@ -150,6 +151,11 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         self._vm_expr = compat.expression(
             von_mises(total_stress(self.u, self.memory.M, p.E, p.nu)), Q)
         self._contact_setup(ds(GAMMA_C))
+        # ||sigma_n||^2 per cell in NumPy (P1 u, DG1 M on affine simplices), else assembled
+        self._stress_norm = None
+        if bookkeeping.AffineStressNorm.applies(self.u, self.memory.M):
+            a, b = B_coefficients(msh.topology.dim, p.E, p.nu)
+            self._stress_norm = bookkeeping.AffineStressNorm(self.u, self.memory.M, a, b)
         sigma = total_stress(self.u, self.memory.M, p.E, p.nu)
         self._stress_sq = compat.form(ufl.inner(sigma, sigma) * ufl.dx)
         self.output_fields = [self.u, self.zeta, self.von_mises]
@@ -187,9 +193,14 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
         compat.interpolate(self.von_mises, self._vm_expr)
 
     def scalars(self) -> dict:
-        """Base scalars, the RMS penetration (u.nu - gap)_+ over Gamma_C and ||sigma_n||_Q."""
-        out = super().scalars()
-        out["stress_L2"] = float(np.sqrt(compat.assemble_scalar(self._stress_sq, self.comm)))
+        """Base scalars, the RMS penetration (u.nu - gap)_+ over Gamma_C and ||sigma_n||_Q
+        (per cell without an assembly where bookkeeping.AffineStressNorm applies: exact)."""
+        if self._stress_norm is not None:  # summed in the base scalars' reduction
+            out, (stress_sq,) = self.base_scalars([self._stress_norm.local()])
+        else:
+            out = super().scalars()
+            stress_sq = compat.assemble_scalar(self._stress_sq, self.comm)
+        out["stress_L2"] = float(np.sqrt(max(stress_sq, 0.0)))
         out["penetration_rms"] = self.penetration_rms()
         return out
 

@@ -34,6 +34,14 @@ def B(tau, E, nu):
     return B_plane_stress(tau, E, nu)
 
 
+def B_coefficients(dim: int, E, nu) -> tuple:
+    """(a, b) with B tau = a tr(tau) I + b tau, the B of :func:`B` on dim x dim tensors."""
+    if dim == 3:
+        lmbda, mu = constitutive3d.lame(E, nu)
+        return lmbda, 2.0 * mu
+    return E * nu / (1.0 - nu**2), E / (1.0 + nu)
+
+
 def _dim(tau) -> int:
     return tau.ufl_shape[0]
 

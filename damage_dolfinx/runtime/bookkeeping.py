@@ -21,6 +21,8 @@
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -211,3 +213,116 @@ class FieldNorms:
         if not z.size:
             return 0.0, np.inf, -np.inf
         return float(np.dot(self.m, z)), float(z.min()), float(z.max())
+
+
+class AffineStressNorm:
+    """||B eps(u) + M||_L2^2 of a P1 vector field u and a DG1 tensor field M (d x d, all d^2
+    components stored) on affine simplices, B tau = a tr(tau) I + b tau, without a form
+    assembly. On a cell T (vertices i = 0..d, measure |T|) c_T = B eps(u) is constant and M is
+    linear with vertex values m_i; with S_T = sum_i m_i and the P1 mass matrix
+    int_T phi_i phi_j = |T| (1 + delta_ij) / ((d+1)(d+2)):
+
+        int_T |c + M|^2 = |T| |c + S/(d+1)|^2 + |T| (q/(d+1) - |S|^2/(d+1)^2) / (d+2),
+        q = sum_i |m_i|^2
+
+    (|T| |c + mean|^2 plus the integral of |M - mean|^2). sqrt(|T|) c_T comes from a sparse
+    matrix of u's local dofs (built once: the P1 gradients of each cell times B), S_T from
+    d + 1 vector sums over M's cell blocks, q from one product: 2.3 Ex. 1 at n = 128, 1.8 ms
+    of form assembly -> about 0.9 ms. Equal to the assembled form to round-off
+    (tests/test_memory_contact_2_3.py). ``local()`` is this rank's part over its owned cells
+    (add over ranks). :meth:`applies` says whether the spaces fit (P1 u, DG1 M with d + 1
+    dofs per cell, simplices with a P1 geometry)."""
+
+    @staticmethod
+    def applies(u, M) -> bool:
+        from damage_dolfinx import compat
+        V, Q = u.function_space, M.function_space
+        msh = V.mesh
+        d = msh.topology.dim
+        return (msh.geometry.x.shape[1] >= d and compat.geometry_dofmap(msh).shape[1] == d + 1
+                and compat.cell_dofs(V).shape[1] == d + 1 and V.dofmap.index_map_bs == d
+                and compat.cell_dofs(Q).shape[1] == d + 1 and Q.dofmap.index_map_bs == d * d
+                and compat.element_degree(V) == 1 and compat.element_degree(Q) == 1
+                and np.allclose(msh.geometry.x[:, d:], 0.0))
+
+    def __init__(self, u, M, a: float, b: float):
+        from damage_dolfinx import compat
+        V, Q = u.function_space, M.function_space
+        d = V.mesh.topology.dim
+        cd = compat.cell_dofs(V)  # (owned cells, d + 1) vertex (block) dofs of u
+        nc, dd = cd.shape[0], d * d
+        x = V.tabulate_dof_coordinates()[:, :d][cd]       # (cells, d + 1, d)
+        edges = x[:, 1:, :] - x[:, :1, :]                 # rows x_k - x_0
+        inv = np.linalg.inv(edges) if nc else np.zeros((0, d, d))  # columns: grad lambda_k
+        volume = np.abs(np.linalg.det(edges)) / math.factorial(d) if nc else np.zeros(0)
+        grads = np.concatenate([-inv.sum(axis=2, keepdims=True), inv], axis=2)  # (c, d, d+1)
+        root = np.sqrt(volume)
+        rows, cols, vals = [], [], []
+        cells = np.arange(nc)
+        for i in range(d):
+            for j in range(d):      # c_ij = a delta_ij tr eps + b (d_j u_i + d_i u_j) / 2
+                for v in range(d + 1):
+                    for l in range(d):
+                        coef = (a * grads[:, l, v] if i == j else 0.0) \
+                            + 0.5 * b * ((grads[:, j, v] if l == i else 0.0)
+                                         + (grads[:, i, v] if l == j else 0.0))
+                        if np.isscalar(coef):
+                            continue
+                        rows.append((i * d + j) * nc + cells)
+                        cols.append(cd[:, v] * d + l)
+                        vals.append(root * coef)
+        n_u = u.x.array.size
+        self.D = _seq_aij(np.concatenate(rows), np.concatenate(cols), np.concatenate(vals),
+                          (dd * nc, n_u))
+        self.u_vec = PETSc.Vec().createWithArray(u.x.array, comm=PETSc.COMM_SELF)
+        self.c = np.zeros(dd * nc)
+        self.c_vec = PETSc.Vec().createWithArray(self.c, comm=PETSc.COMM_SELF)
+        gc = compat.cell_dofs(Q).ravel()  # DG1 blocks of the owned cells
+        blocks = (gc[:, None] * dd + np.arange(dd)).ravel()
+        self._take = None if np.array_equal(blocks, np.arange(blocks.size)) else blocks
+        self.M, self.n_values = M, blocks.size
+        self._m = np.empty(blocks.size)
+        self._buf = np.empty(blocks.size)
+        self.S = np.empty((dd, nc))
+        self.mean_scale = root / (d + 1)                         # sqrt|T| S / (d+1)
+        self.q_weight = np.repeat(volume / ((d + 1) * (d + 2)), (d + 1) * dd)
+        self.d, self.nc = d, nc
+
+    def local(self) -> float:
+        """int over this rank's owned cells of |B eps(u) + M|^2."""
+        d, dd, nc = self.d, self.d * self.d, self.nc
+        if not nc:
+            return 0.0
+        self.D.mult(self.u_vec, self.c_vec)             # sqrt|T| c_T, component-major
+        values = self.M.x.array
+        m = values[:self.n_values] if self._take is None else \
+            np.take(values, self._take, out=self._m)
+        blocks = m.reshape(nc, d + 1, dd).transpose(1, 2, 0)  # (vertex, component, cell)
+        S = self.S
+        np.add(blocks[0], blocks[1], out=S)
+        for i in range(2, d + 1):
+            np.add(S, blocks[i], out=S)
+        S *= self.mean_scale                             # sqrt|T| S / (d + 1)
+        t = S.ravel() + self.c                           # sqrt|T| (c + mean m)
+        mean_part = float(np.dot(t, t))
+        spread = float(np.multiply(np.multiply(m, m, out=self._buf), self.q_weight,
+                                   out=self._buf).sum())
+        # int |M - mean|^2 = sum |T| q/((d+1)(d+2)) - |sqrt|T| S/(d+1)|^2/(d+2)
+        return mean_part + spread - float(np.dot(S.ravel(), S.ravel())) / (d + 2)
+
+
+def _seq_aij(rows, cols, vals, shape) -> PETSc.Mat:
+    """A serial AIJ matrix (this rank's local rows and columns) from COO entries (summed)."""
+    order = np.lexsort((cols, rows))
+    rows, cols, vals = rows[order], cols[order], vals[order]
+    keep = np.ones(rows.size, bool)
+    keep[1:] = (rows[1:] != rows[:-1]) | (cols[1:] != cols[:-1])
+    start = np.flatnonzero(keep)
+    vals = np.add.reduceat(vals, start) if vals.size else vals
+    rows, cols = rows[start], cols[start]
+    indptr = np.zeros(shape[0] + 1, dtype=PETSc.IntType)
+    np.cumsum(np.bincount(rows, minlength=shape[0]), out=indptr[1:])
+    A = PETSc.Mat().createAIJ(size=shape, csr=(indptr, cols.astype(PETSc.IntType), vals),
+                              comm=PETSc.COMM_SELF)
+    A.assemble()
+    return A
