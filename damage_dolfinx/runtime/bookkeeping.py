@@ -303,12 +303,14 @@ class AffineStressNorm:
         for i in range(2, d + 1):
             np.add(S, blocks[i], out=S)
         S *= self.mean_scale                             # sqrt|T| S / (d + 1)
-        t = S.ravel() + self.c                           # sqrt|T| (c + mean m)
-        mean_part = float(np.dot(t, t))
+        S = S.ravel()
+        t = np.add(S, self.c, out=self.c)                # sqrt|T| (c + mean m)
+        # einsum, not np.dot: the reference BLAS's ddot is 2x slower here
+        mean_part = float(np.einsum("i,i->", t, t))
         spread = float(np.multiply(np.multiply(m, m, out=self._buf), self.q_weight,
                                    out=self._buf).sum())
         # int |M - mean|^2 = sum |T| q/((d+1)(d+2)) - |sqrt|T| S/(d+1)|^2/(d+2)
-        return mean_part + spread - float(np.dot(S.ravel(), S.ravel())) / (d + 2)
+        return mean_part + spread - float(np.einsum("i,i->", S, S)) / (d + 2)
 
 
 def _seq_aij(rows, cols, vals, shape) -> PETSc.Mat:
