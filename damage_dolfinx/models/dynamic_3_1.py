@@ -41,7 +41,7 @@ from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
-from damage_dolfinx.forms.dynamic_kelvin_voigt import total_stress, velocity_step_forms
+from damage_dolfinx.forms.dynamic_kelvin_voigt import inertia_form, total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
 from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
@@ -111,9 +111,15 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
                                    self.u_old, self.zeta_old, const(self.rho), const(self.k), p.E,
                                    p.nu, self.m_visc, p.L_trunc, const(self.c_nu),
                                    const(self.gap), self.n_facet, f_B, f_N, ds(GAMMA_N),
-                                   ds(GAMMA_C) if self.has_contact else None)
+                                   ds(GAMMA_C) if self.has_contact else None,
+                                   inertia_rhs=False)
         self.bcs = [clamped(V, tags, GAMMA_D)]
+        # (rho v_{n-1}/k, w)_H as M_rho/k v_{n-1}: the mass matrix made once, one sparse product
+        # a step instead of a second quadrature loop and v_{n-1}'s coefficients in the assembly
+        inertia = (inertia_form(ufl.TrialFunction(V), ufl.TestFunction(V), const(self.rho),
+                                const(self.k)), self.v_old)
         self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context, constant_matrix=True,
+                                 rhs_product=inertia,
                                  defaults=scalable.constant_config(
                                      V, serial_cholesky(msh.comm, DIRECT), mech_prefix))
         scalable.prepare_mech(self.mech, V)  # near-nullspace; with AMG: warm start

@@ -123,11 +123,25 @@ class LinearSolver:
     Krylov KSP (default options LAGGED_DIRECT) the preconditioner (an exact factorisation of an
     earlier matrix) is kept until the iteration count exceeds that number, and rebuilt at once
     if the lagged solve fails.
+
+    ``rhs_product=(r, f)`` (r a bilinear form, f a Function) adds R f to the right-hand side,
+    R the matrix of r assembled once (no boundary conditions): a term r(f, w) of the linear
+    form taken out of L, e.g. the inertia (rho v_{n-1}/k, w) as M v_{n-1}/k (one sparse product
+    instead of a quadrature loop and its coefficient packing at every assembly). When every
+    Dirichlet value is zero (checked at each assembly) the lifting is skipped: it would
+    subtract A 0.
     """
 
     def __init__(self, a, L, bcs, prefix: str, context: SolveContext, constant_matrix=False,
-                 defaults=None, refactor_after_its=None):
+                 defaults=None, refactor_after_its=None, rhs_product=None):
         self.a, self.L, self.bcs = compat.form(a), compat.form(L), list(bcs)
+        self._product = None
+        if rhs_product is not None:
+            r, f = rhs_product
+            R = compat.create_matrix(compat.form(r))
+            compat.assemble_matrix(R, compat.form(r), [])
+            R.assemble()
+            self._product = (R, compat.petsc_vec(f))
         self.prefix, self.context, self.constant_matrix = prefix, context, constant_matrix
         self.A = compat.create_matrix(self.a)
         self.b = compat.create_vector(self.L)
@@ -159,8 +173,12 @@ class LinearSolver:
         with self.b.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(self.b, self.L)
-        compat.apply_lifting(self.b, self.a, self.bcs)
+        if not compat.dirichlet_values_zero(self.bcs):
+            compat.apply_lifting(self.b, self.a, self.bcs)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        if self._product is not None:
+            R, f = self._product
+            R.multAdd(f, self.b, self.b)  # owned entries; the Dirichlet rows are set next
         compat.set_bc(self.b, self.bcs)
         self.timings["assemble_rhs"] += time.perf_counter() - start
 
