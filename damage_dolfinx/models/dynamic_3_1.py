@@ -42,7 +42,7 @@ from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import inertia_form, total_stress, velocity_step_forms
-from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_cholesky
+from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_block_lu
 from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
@@ -119,9 +119,9 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         inertia = (inertia_form(ufl.TrialFunction(V), ufl.TestFunction(V), const(self.rho),
                                 const(self.k)), self.v_old)
         self.mech = LinearSolver(a, l, self.bcs, mech_prefix, self.context, constant_matrix=True,
-                                 rhs_product=inertia,
+                                 rhs_product=inertia, block_matrix=True,
                                  defaults=scalable.constant_config(
-                                     V, serial_cholesky(msh.comm, DIRECT), mech_prefix))
+                                     V, serial_block_lu(msh.comm, DIRECT), mech_prefix))
         scalable.prepare_mech(self.mech, V)  # near-nullspace; with AMG: warm start
         self.stability = self._stability_check(V, x, ds(GAMMA_C))
 
