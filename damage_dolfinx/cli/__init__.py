@@ -25,20 +25,23 @@ import sys
 #: set by an MPI launcher (Open MPI's mpirun, PMIx, PMI: MPICH's hydra, Slurm's srun) in the
 #: environment of the processes it starts
 _LAUNCHER_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE")
-#: Open MPI's transports of a process alone: shared memory and TCP only, the pml without UCX
-#: (the values the Makefile gives the tests and demos)
-_SINGLETON_TRANSPORTS = {"OMPI_MCA_btl": "^ofi,uct", "OMPI_MCA_pml": "ob1"}
+#: Open MPI's settings of a process alone: shared memory and TCP only, the pml without UCX
+#: (the values the Makefile gives the tests and demos), and no supporting daemon (orted: a
+#: singleton then cannot spawn processes, which the package never does)
+_SINGLETON_SETTINGS = {"OMPI_MCA_btl": "^ofi,uct", "OMPI_MCA_pml": "ob1",
+                       "OMPI_MCA_ess_singleton_isolated": "1"}
 
 
 def _start_mpi():
     """MPI_Init (the import of mpi4py.MPI). A command that no MPI launcher started is one rank
-    alone and talks to no other process, yet Open MPI probes every network transport at its
-    start: libfabric's providers and UCX took 0.2 s of each start on Open MPI 4.1 (0.38 against
-    0.17 s), about 1 s under Open MPI 6. Such a process starts with _SINGLETON_TRANSPORTS, for
-    MPI_Init only: a value set outside is kept, and the variables are taken out again (a
-    process it starts does not inherit them). Other MPI libraries ignore them."""
+    alone and talks to no other process, yet Open MPI starts a daemon for it and probes every
+    network transport: on Open MPI 4.1 here MPI_Init took 0.38 s, 0.17 s without the probes of
+    libfabric's providers and UCX, 0.05 s without the daemon (the probes take about 1 s under
+    Open MPI 6). Such a process starts with _SINGLETON_SETTINGS, for MPI_Init only: a value
+    set outside is kept, and the variables are taken out again (a process it starts does not
+    inherit them). Other MPI libraries ignore them."""
     added = {} if any(v in os.environ for v in _LAUNCHER_VARIABLES) else \
-        {k: v for k, v in _SINGLETON_TRANSPORTS.items() if k not in os.environ}
+        {k: v for k, v in _SINGLETON_SETTINGS.items() if k not in os.environ}
     os.environ.update(added)
     try:
         from mpi4py import MPI  # noqa: F401  (MPI_Init)
