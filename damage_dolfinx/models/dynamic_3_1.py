@@ -10,9 +10,11 @@ inclusion (variant A), scheme (3.48)-(3.51):
 
 V = {v = 0 on Gamma_D}; u_0 = v_0 = 0, zeta_0 from the example. The matrix of (2) does not change
 for a fixed k: it is factorised once (prefix ``mech_``), each step assembles a right-hand
-side. It is SPD (the Dirichlet rows are identity rows), so serially it is factorised by PETSc's
-own Cholesky (solvers.serial_cholesky; 3.1-ex1 at n = 255, 131k dofs, velocity step
-90 -> 41 ms; at n = 45, 4k dofs, 2.8 -> 1.3 ms) and by MUMPS LU in parallel. The dimension comes
+side. Serially it is stored by 2x2 (3x3) blocks and factorised by PETSc's own LU with nested
+dissection (solvers.serial_block_lu: at n = 128, 33k dofs, solve 3.5 -> 1.8-2.1 ms and
+factorisation 430 -> 200 ms against PETSc's scalar Cholesky, itself 2x faster than MUMPS's
+solves), by MUMPS LU in parallel. The right-hand side's inertia term is M_rho/k v_{n-1}, the
+mass matrix assembled once (LinearSolver's rhs_product). The dimension comes
 from the mesh: on 3-D meshes with at least
 ``VELOCITY_DIRECT_MAX_DOFS_3D`` unknowns the velocity system is solved by CG + GAMG with the
 rigid-body near-nullspace (AMG set up once, CG started from v_{n-1}) instead.
