@@ -6,10 +6,14 @@ row) rather than to the scheme's solves:
 
 One run in this process (no figures, fields written only at the end, no timed checkpoints).
 Per step: ``whole`` = wall time between two consecutive steps handed to on_step, ``solve`` =
-the step's ``step_time_s`` of history.csv (the scheme's advance); bookkeeping = whole - solve.
-Prints the medians over the steps after the warm-up (the last step, which writes the fields,
-left out); with --history-every N > 1 over the steps with a history row (solve) and over all
-(whole)."""
+the step's ``step_time_s`` of history.csv (the scheme's advance); bookkeeping = whole - solve
+of the same step. Prints the medians over the steps after the warm-up (the last step, which
+writes the fields, left out): of whole, of solve, of the per-step bookkeeping, and the share
+median(bookkeeping) / median(whole) (the median of the per-step differences: a step slowed
+by other work on the machine moves it less than the difference of the two medians, printed
+after it as "medians' difference"); with --history-every N > 1 (the steps without a row have no
+solve time) the solve over the steps with a history row, the whole over all, and the
+bookkeeping is the medians' difference."""
 import argparse
 import csv
 import statistics
@@ -43,11 +47,13 @@ def main():
     steps = [n for n in range(args.warmup + 1, N) if n in rows]
     whole = {n: stamps[n] - stamps[n - 1] for n in range(args.warmup + 1, N)}
     w = statistics.median(whole.values())
-    b = w - statistics.median(rows[n] for n in steps)
+    s = statistics.median(rows[n] for n in steps)
+    b = statistics.median(whole[n] - rows[n] for n in steps) if args.history_every == 1 \
+        else w - s
     print(f"{args.example} n = {args.n}, history every {args.history_every}: "
-          f"step {w * 1e3:.2f} ms, solve {statistics.median(rows[n] for n in steps) * 1e3:.2f} "
-          f"ms, bookkeeping "
-          f"{b * 1e3:.2f} ms ({100 * b / w:.1f} %) (median of {len(steps)} steps)")
+          f"step {w * 1e3:.2f} ms, solve {s * 1e3:.2f} ms, bookkeeping {b * 1e3:.2f} ms "
+          f"({100 * b / w:.1f} %) (medians of {len(steps)} steps; medians' difference "
+          f"{(w - s) * 1e3:.2f} ms, {100 * (w - s) / w:.1f} %)")
 
 
 if __name__ == "__main__":

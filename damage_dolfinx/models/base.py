@@ -191,11 +191,19 @@ class Model:
     def restore(self, n: int):
         """Continue from time level n after checkpoint.load() has set checkpoint_state()."""
         self._set_time(n)
+        self._forget_norms()
+
+    def _forget_norms(self):
+        """The products the scalars carry from step to step start afresh (a loaded state)."""
+        norms = getattr(self, "_field_norms", None)
+        if norms is not None:
+            norms.forget()
 
     # -- time loop interface
     def initialize(self) -> dict:
         """t = 0: zeta_0 (u_0 = v_0 = 0, the Functions' initial value), then :meth:`start`."""
         self._set_time(0)
+        self._forget_norms()
         self.initial_damage()
         self.zeta_old.x.array[:] = self.zeta.x.array
         return self.start()
@@ -329,26 +337,22 @@ class Model:
     def scalars(self) -> dict:
         """||u||_L2, ||eps(u)||_L2, min/max/mean zeta (the summary.json 'final' block), from
         matrices assembled once: u^T M u, u^T K_eps u and m . zeta with m_i = int phi_i (exact
-        for P1 fields; no assembly per step)."""
-        if not hasattr(self, "_norm_operators"):
-            self._norm_operators = self._assemble_norm_operators()
-        M, K, m, area, y = self._norm_operators
-        u, dot = compat.petsc_vec(self.u), bookkeeping.local_dot  # this rank's part
-        M.mult(u, y)
-        parts = [dot(u, y)]
-        K.mult(u, y)
-        parts += [dot(u, y), dot(m, compat.petsc_vec(self.zeta))]
-        owned = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
-        lo, hi = (owned.min(), owned.max()) if owned.size else (np.inf, -np.inf)
+        for P1 fields; no assembly per step), in one reduction."""
+        norms = self.field_norms()
+        parts = norms.u_parts()
+        zeta_integral, lo, hi = norms.zeta_parts()
         (u_L2_sq, eps_sq, zeta_integral), (neg_min, zeta_max) = \
-            bookkeeping.sums_and_maxima(self.comm, parts, [-lo, hi])  # one reduction
-        zeta_min = -neg_min
+            bookkeeping.sums_and_maxima(self.comm, parts + [zeta_integral], [-lo, hi])
         return {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
-                "zeta_min": zeta_min, "zeta_max": zeta_max,
-                "zeta_mean": float(zeta_integral / area)}
+                "zeta_min": -neg_min, "zeta_max": zeta_max,
+                "zeta_mean": float(zeta_integral / norms.area)}
 
-    def _assemble_norm_operators(self):
-        return bookkeeping.norm_operators(self.u.function_space, self.zeta.function_space)
+    def field_norms(self) -> bookkeeping.FieldNorms:
+        """The norm operators of u and zeta with their owned views (built at the first call)."""
+        norms = getattr(self, "_field_norms", None)
+        if norms is None:
+            norms = self._field_norms = bookkeeping.FieldNorms(self.u, self.zeta)
+        return norms
 
     # -- contact
     def contact_pressure(self):

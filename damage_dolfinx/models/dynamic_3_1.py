@@ -199,43 +199,20 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
         (M u_{n-1} kept from the previous step's scalars; computed directly after a restart,
         at t = 0 or after a step without scalars). Equal to the direct products to round-off
         (relative 1e-16 per step)."""
-        if not hasattr(self, "_norm_operators"):
-            self._norm_operators = self._assemble_norm_operators()
-            self._Mu, self._Mv = self._norm_operators[-1].duplicate(), \
-                self._norm_operators[-1].duplicate()
-            self._Mu_at = None
-        M, K, m, area, y = self._norm_operators
-        u, v, dot = compat.petsc_vec(self.u), compat.petsc_vec(self.v), bookkeeping.local_dot
-        Mu, Mv = self._Mu, self._Mv
-        M.mult(v, Mv)
-        if self._Mu_at == self.n - 1:
-            Mu.axpy(self.k, Mv)  # M u_n = M u_{n-1} + k M v_n  (3.51)
-        elif self._Mu_at != self.n:
-            M.mult(u, Mu)
-        self._Mu_at = self.n
-        K.mult(u, y)
+        norms = self.field_norms()
+        u_sq, eps_sq, v_sq = norms.carried_parts(self.v, self.n, self.k)  # (3.51)
+        values = norms.u
+        zeta_integral, lo, hi = norms.zeta_parts()
         d = self.mesh.topology.dim
-        zeta = self.zeta.x.array[:self.zeta.function_space.dofmap.index_map.size_local]
-        lo, hi = (zeta.min(), zeta.max()) if zeta.size else (np.inf, -np.inf)
-        values = self.u.x.array[:self.u.function_space.dofmap.index_map.size_local * d]
-        sq = values[0::d] ** 2
-        for c in range(1, d):
-            sq += values[c::d] ** 2
+        nodes = values.reshape(-1, d)
+        u_max_sq = float(np.einsum("ij,ij->i", nodes, nodes).max()) if nodes.size else 0.0
         (u_sq, eps_sq, zeta_integral, v_sq), (neg_min, zeta_max, u_max_sq) = \
-            bookkeeping.sums_and_maxima(self.comm, [dot(u, Mu), dot(u, y), dot(m, compat.petsc_vec(
-                self.zeta)), dot(v, Mv)], [-lo, hi, sq.max() if sq.size else 0.0])
+            bookkeeping.sums_and_maxima(self.comm, [u_sq, eps_sq, zeta_integral, v_sq],
+                                        [-lo, hi, u_max_sq])
         return {"u_L2": float(np.sqrt(max(u_sq, 0.0))), "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
                 "zeta_min": -neg_min, "zeta_max": zeta_max,
-                "zeta_mean": float(zeta_integral / area), "v_L2": float(np.sqrt(abs(v_sq))),
+                "zeta_mean": float(zeta_integral / norms.area), "v_L2": float(np.sqrt(abs(v_sq))),
                 "u_max": float(np.sqrt(u_max_sq)), "penetration_rms": self.penetration_rms()}
-
-    def restore(self, n: int):
-        super().restore(n)
-        self._Mu_at = None  # M u from the loaded u
-
-    def initialize(self) -> dict:
-        self._Mu_at = None
-        return super().initialize()
 
     def iteration_totals(self) -> dict:
         return {"damage_snes": self.damage.iterations if self.damage else 0,

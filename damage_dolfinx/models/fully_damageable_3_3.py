@@ -47,6 +47,7 @@ from mpi4py import MPI
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
+from damage_dolfinx.runtime import bookkeeping
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.numerics.constitutive import eps, von_mises
 from damage_dolfinx.forms.fully_damageable import (implicit_velocity_residual, total_stress,
@@ -290,31 +291,19 @@ class FullyDamageableContact(Model):
 
     # -- scalars and summary
     def scalars(self) -> dict:
-        """The base scalars (the same operations as Model.scalars, so the same values)
-        plus v_L2, the interpenetration and the probe. The runner asks for them after every
-        step (history.csv), so the vectors and views are cached and the extrema take one
-        Allreduce, none in serial (120 -> 40 us per wrench step)."""
-        if not hasattr(self, "_scalar_cache"):
-            self._norm_operators = self._assemble_norm_operators()
-            owned = self.zeta.function_space.dofmap.index_map.size_local
-            self._scalar_cache = ([compat.petsc_vec(f) for f in (self.u, self.v, self.zeta)],
-                                  self.zeta.x.array[:owned], np.empty(2))
-        M, K, m, area, y = self._norm_operators
-        (u, v, z), owned, ext = self._scalar_cache
-        M.mult(u, y)
-        u_L2_sq = u.dot(y)
-        K.mult(u, y)
-        eps_sq = u.dot(y)
-        M.mult(v, y)
-        v_sq = v.dot(y)
-        zeta_integral = m.dot(z)
-        ext[:] = (-owned.min(), owned.max()) if owned.size else (-np.inf, -np.inf)
-        if self.comm.size > 1:
-            self.comm.Allreduce(MPI.IN_PLACE, ext, op=MPI.MAX)
+        """The base scalars (the same operations as Model.scalars, so the same values) plus
+        v_L2, the interpenetration and the probe; the sums and extrema in one reduction (none
+        in serial). Each row's products are its own (M u_n directly, not carried by (3.160)
+        from the previous row), so that a history cadence gives the same rows bit for bit."""
+        norms = self.field_norms()
+        parts = norms.u_parts() + [norms.mass_parts(self.v)]
+        zeta_integral, lo, hi = norms.zeta_parts()
+        (u_L2_sq, eps_sq, v_sq, zeta_integral), (neg_min, zeta_max) = \
+            bookkeeping.sums_and_maxima(self.comm, parts + [zeta_integral], [-lo, hi])
         out = {"u_L2": float(np.sqrt(max(u_L2_sq, 0.0))),
                "eps_u_L2": float(np.sqrt(max(eps_sq, 0.0))),
-               "zeta_min": float(-ext[0]), "zeta_max": float(ext[1]),
-               "zeta_mean": float(zeta_integral / area),
+               "zeta_min": -neg_min, "zeta_max": zeta_max,
+               "zeta_mean": float(zeta_integral / norms.area),
                "v_L2": float(np.sqrt(abs(v_sq)))}  # = ||v||_L2: v^T M v, no assembly
         out.update(self.contact(self.u, self.t))
         out.update(self.probe(self.zeta, self.t, self.params.zeta_star))

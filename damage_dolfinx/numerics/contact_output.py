@@ -180,19 +180,55 @@ class ContactOutput:
             return cls.attach(stepper, pressure=pressure, gap=gap)
         problem = getattr(stepper, "friction_problem", None)
         if problem is not None:
-            return cls.attach(stepper, residual=ufl.action(problem.a, problem.v) - problem.l,
-                              slip_rate=problem.v,
-                              eps_slip=float(stepper.params.extra.get("eps_reg", 1e-9)))
+            out = cls.attach(stepper, residual=ufl.action(problem.a, problem.v) - problem.l,
+                             slip_rate=problem.v,
+                             eps_slip=float(stepper.params.extra.get("eps_reg", 1e-9)))
+            if out is not None:
+                out.tap_friction_rhs(stepper, problem)
+            return out
         mech = getattr(stepper, "mech", None)
         if "bilateral" in getattr(stepper, "contact_roles", ()) and hasattr(mech, "a") \
                 and hasattr(mech, "L"):
             return cls.attach(stepper, residual=(mech.a, mech.L))
         return None
 
+    def tap_friction_rhs(self, stepper, problem):
+        """Serially, where the friction solver assembles l itself every step (its algebraic
+        residual's ``rhs_taps``): the reaction R = A v - l at the contact nodes from the rows of
+        A there (the matrix of ``a`` without boundary conditions, assembled once) and the
+        entries of l there, copied as the solver assembles l. The same numbers as the residual
+        assembled over the strip of cells (sums in another order), without an assembly per row
+        (2.2, 2.4, 3.2 Ex. 1 at n = 128: 0.3-0.4 ms in the loop). Used for the step whose l was
+        tapped (``stepper.n``); any other step, and on several ranks, assembles."""
+        residual = getattr(getattr(stepper, "friction", None), "residual", None)
+        taps = getattr(residual, "rhs_taps", None)
+        if taps is None or self.comm.size > 1:
+            return
+        import scipy.sparse
+        a = compat.form(problem.a)
+        A = compat.create_matrix(a)
+        compat.assemble_matrix(A, a, [])
+        A.assemble()
+        indptr, indices, values = A.getValuesCSR()
+        rows = (self.dim * self.nodes[:, None] + np.arange(self.dim)).ravel()
+        self._rows = scipy.sparse.csr_matrix((values, indices, indptr), shape=A.getSize())[rows]
+        A.destroy()
+        self._tapped = {"v": problem.v.x.array, "l": np.zeros(rows.size), "at": None,
+                        "stepper": stepper}
+
+        def tap(b):
+            self._tapped["l"][:] = b.getArray(readonly=True)[rows]
+            self._tapped["at"] = stepper.n
+        taps.append(tap)
+
     def _nodal(self, tangential=True):
         """(F (nodes, dim), p (nodes,), F_tau (nodes, dim), or None without ``tangential``) on
         the owned contact nodes."""
-        F = self._forces().reshape(-1, self.dim)[self.nodes]
+        tapped = getattr(self, "_tapped", None)
+        if tapped is not None and tapped["at"] == tapped["stepper"].n:
+            F = (self._rows @ tapped["v"] - tapped["l"]).reshape(-1, self.dim)
+        else:
+            F = self._forces().reshape(-1, self.dim)[self.nodes]
         Fn = np.einsum("ij,ij->i", F, self.nu)
         return F, -Fn / self._m_nodes, F - Fn[:, None] * self.nu if tangential else None
 
@@ -229,19 +265,27 @@ class ContactOutput:
         b.destroy()
         return out
 
+    def _owned_nodes(self):
+        """(u, v or None) at the owned contact nodes, (nodes, dim), from views of the owned
+        values taken once."""
+        if not hasattr(self, "_views"):
+            n = self.V.dofmap.index_map.size_local * self.dim
+            self._views = [f.x.array[:n].reshape(-1, self.dim) if f is not None else None
+                           for f in (self.u, self.slip_rate)]
+        return [None if a is None else a[self.nodes] for a in self._views]
+
     def scalars(self) -> dict:
         F, p, F_tau = self._nodal(tangential=self.slip_rate is not None)
-        m, d = self._m_nodes, self.dim
-        owned = self.V.dofmap.index_map.size_local
-        un = np.einsum("ij,ij->i", self.u.x.array[:owned * d].reshape(-1, d)[self.nodes], self.nu)
+        m, d, nu = self._m_nodes, self.dim, self.nu
+        u, v = self._owned_nodes()
+        un = np.einsum("ij,ij->i", u, nu)
         if self.compliance:
             in_contact, penetration = p > 0, np.maximum(un - self.gap, 0.0)
         else:
             in_contact, penetration = None, np.abs(un)
         sums = [np.dot(p, m), *F.sum(axis=0), np.sum(m[in_contact]) if self.compliance else 0.0]
-        if self.slip_rate is not None:
-            v = self.slip_rate.x.array[:owned * d].reshape(-1, d)[self.nodes]
-            v_tau = v - np.einsum("ij,ij->i", v, self.nu)[:, None] * self.nu
+        if v is not None:
+            v_tau = v - np.einsum("ij,ij->i", v, nu)[:, None] * nu
             sliding = np.sqrt(np.einsum("ij,ij->i", v_tau, v_tau)) > self.eps_slip
             if d == 2:
                 sums += [np.sum(F_tau * self._tau), np.sum(m[sliding])]
@@ -253,7 +297,7 @@ class ContactOutput:
         out = {"contact_normal_force": sums[0], f"contact_{self._size}": size,
                "contact_penetration": peak,
                **{f"contact_force_{c}": sums[1 + i] for i, c in enumerate("xyz"[:d])}}
-        if self.slip_rate is not None:
+        if v is not None:
             friction = sums[d + 2] if d == 2 else float(np.linalg.norm(sums[d + 2:2 * d + 2]))
             out.update({"friction_force": float(friction), f"slip_{self._size}": sums[-1]})
         return {key: float(value) for key, value in out.items()}

@@ -1,9 +1,10 @@
 """The cost of a step's history scalars: the products and extrema behind ||u||_L2,
 ||eps(u)||_L2, ||v||_L2, min/max zeta and max |u| (history.csv, summary.json), taken every step.
 
-* :func:`norm_matrix`: the norm matrices of vector fields in block (BAIJ) storage, one column
-  index per d x d block: the product reads a quarter less memory (3.1 Ex. 1 at n = 128:
-  0.17 -> 0.13 ms per product, the same values to rounding).
+* :func:`norm_matrix`: the norm matrices of vector fields in symmetric block (SBAIJ) storage,
+  one column index per d x d block of the upper triangle: the product reads about half the
+  memory of AIJ (3.1 Ex. 1 at n = 128, in the loop: 0.36 ms per product with BAIJ, about
+  0.3 with SBAIJ; the same values to rounding).
 * :func:`norm_operators`: those matrices and the integration vector of a model, assembled once.
 * :func:`extrema`: several minima and maxima of owned arrays in one Allreduce (min a = -max -a).
 * :func:`max_node_norm`: max over the nodes of |u(x_i)| from the squared components, without
@@ -13,8 +14,10 @@
 * :class:`PiecewiseConstantNorm`: ||f||_L2^2 of a DG0 Function (any value shape) as w . f^2,
   w_j = int phi_j dx assembled once: no form assembly per step (2.4 Ex. 1 at n = 128:
   ||sigma_n||_Q 0.8 -> 0.05 ms).
-* :func:`local_dot`: x . y of the owned entries of two PETSc vectors, without the reduction of
-  ``Vec.dot`` (the reductions are then gathered into one).
+* :class:`FieldNorms`: the norm operators of a model together with the owned views of its
+  fields, looked up once: a history row then costs the two matrix products, three dot
+  products and the extrema of zeta, and no lookup; ``carried_parts`` adds ||v||_L2 without a
+  third product where u_n = u_{n-1} + k v_n (M u_n = M u_{n-1} + k M v_n).
 """
 from __future__ import annotations
 
@@ -24,14 +27,18 @@ from petsc4py import PETSc
 
 
 def norm_matrix(a_form, block_size: int) -> PETSc.Mat:
-    """The assembled matrix of ``a_form`` (no boundary conditions), in block storage (BAIJ)
-    when ``block_size`` > 1. Assembled into BAIJ directly: MatConvert from AIJ takes 0.8 s at
-    33k dofs where the assembly takes 0.01 s."""
+    """The assembled matrix of ``a_form`` (symmetric, no boundary conditions), in symmetric
+    block storage (SBAIJ: the upper triangle of d x d blocks) when ``block_size`` > 1.
+    Assembled into BAIJ directly (MatConvert from AIJ takes 0.8 s at 33k dofs where the
+    assembly takes 0.01 s), then converted to SBAIJ (1 ms): the product reads about half the
+    matrix. In a run's loop, where the solves have just evicted the matrices from the caches,
+    that is what a product costs (3.1 Ex. 1 at n = 128: a history row 1.76 -> 1.64 ms, two
+    products; in isolation, with warm caches, SBAIJ is no faster)."""
     from damage_dolfinx import compat
     A = compat.create_matrix(a_form, "baij" if block_size > 1 else None)
     compat.assemble_matrix(A, a_form, [])
     A.assemble()
-    return A
+    return A.convert("sbaij") if block_size > 1 else A
 
 
 def norm_operators(V, Z) -> tuple:
@@ -98,11 +105,6 @@ def sums_and_maxima(comm, sums=(), maxima=()) -> tuple[list, list]:
     return [float(x) for x in buf[1:1 + k]], [float(x) for x in buf[1 + k:]]
 
 
-def local_dot(x: PETSc.Vec, y: PETSc.Vec) -> float:
-    """x . y over this rank's owned entries (add over ranks to get the dot product)."""
-    return float(np.dot(x.getArray(readonly=True), y.getArray(readonly=True)))
-
-
 class PiecewiseConstantNorm:
     """||f||_L2^2 = int f : f dx of a DG0 Function f (scalar, vector or tensor values): the
     integrand is constant on each cell, so the integral is sum_j w_j f_j^2 over the owned dofs,
@@ -127,5 +129,85 @@ class PiecewiseConstantNorm:
         self.f = f
 
     def local(self) -> float:
+        """sum_j w_j f_j^2 over the owned dofs, in one pass (no temporary f^2: 2.4 Ex. 1 at
+        n = 128, 131k values, 0.19 -> 0.14 ms after a cache flush)."""
         values = self.f.x.array[:self.weights.size]
-        return float(np.dot(self.weights, values * values))
+        return float(np.einsum("i,i,i->", self.weights, values, values))
+
+
+class FieldNorms:
+    """This rank's parts of the base scalars of a model with a P1 vector field u and a P1
+    scalar field zeta: u^T M u = ||u||_L2^2, u^T K_eps u = ||eps(u)||_L2^2 and m . zeta = int zeta
+    (:func:`norm_operators`), and min/max zeta over the owned dofs. The owned value arrays are
+    views of the Functions' arrays (valid for the Functions' lifetime), taken once."""
+
+    def __init__(self, u, zeta):
+        from damage_dolfinx import compat
+        V, Z = u.function_space, zeta.function_space
+        self.M, self.K, m, self.area, self.y = norm_operators(V, Z)
+        self.m = m.getArray(readonly=True).copy()
+        self.u_vec = compat.petsc_vec(u)
+        self.u = u.x.array[:V.dofmap.index_map.size_local * V.dofmap.index_map_bs]
+        self.zeta = zeta.x.array[:Z.dofmap.index_map.size_local]
+        self.y, self.y_array = self.work_vector()
+
+    def work_vector(self) -> tuple:
+        """(a PETSc vector of M's rows, its values as a NumPy array): the vector is made on the
+        array, so that products written into it are read without VecGetArray."""
+        (local, size), _ = self.M.getSizes()
+        array = np.zeros(local)
+        vec = PETSc.Vec().createWithArray(array, size=(local, size), bsize=self.M.getBlockSize(),
+                                          comm=self.M.getComm())
+        return vec, array
+
+    def u_parts(self) -> list:
+        """[u^T M u, u^T K_eps u] (this rank's parts)."""
+        y, y_owned, u, u_owned = self.y, self.y_array, self.u_vec, self.u
+        self.M.mult(u, y)
+        mass = float(np.dot(u_owned, y_owned))
+        self.K.mult(u, y)
+        return [mass, float(np.dot(u_owned, y_owned))]
+
+    def carried_parts(self, v, n: int, k: float) -> list:
+        """[u^T M u, u^T K_eps u, v^T M v] (this rank's parts) at step ``n`` of a scheme with
+        u_n = u_{n-1} + k v_n (``v`` the Function v_n): two products instead of three, M v_n
+        and K u_n, with M u_n = M u_{n-1} + k M v_n from the M u kept by the call at step
+        n - 1 (a direct product M u_n at any other step: t = 0, after a step without scalars,
+        after :meth:`forget`). Equal to the direct products to round-off (relative 1e-16 per
+        step)."""
+        if not hasattr(self, "_carried"):
+            from damage_dolfinx import compat
+            self._carried = (*self.work_vector(), *self.work_vector(), compat.petsc_vec(v),
+                             v.x.array[:self.u.size])
+        Mu, Mu_owned, Mv, Mv_owned, v_vec, v_owned = self._carried
+        self.M.mult(v_vec, Mv)
+        at = getattr(self, "_Mu_at", None)
+        if at == n - 1:
+            Mu.axpy(k, Mv)  # M u_n = M u_{n-1} + k M v_n
+        elif at != n:
+            self.M.mult(self.u_vec, Mu)
+        self._Mu_at = n
+        self.K.mult(self.u_vec, self.y)
+        u = self.u
+        return [float(np.dot(u, Mu_owned)), float(np.dot(u, self.y_array)),
+                float(np.dot(v_owned, Mv_owned))]
+
+    def mass_parts(self, v) -> float:
+        """v^T M v (this rank's part) of a P1 vector Function ``v`` of u's space."""
+        if not hasattr(self, "_mass_v"):
+            from damage_dolfinx import compat
+            self._mass_v = (compat.petsc_vec(v), v.x.array[:self.u.size])
+        vec, owned = self._mass_v
+        self.M.mult(vec, self.y)
+        return float(np.dot(owned, self.y_array))
+
+    def forget(self):
+        """The next :meth:`carried_parts` computes M u directly (the state was loaded)."""
+        self._Mu_at = None
+
+    def zeta_parts(self) -> tuple:
+        """(m . zeta, min zeta, max zeta) over the owned dofs (+inf / -inf where none)."""
+        z = self.zeta
+        if not z.size:
+            return 0.0, np.inf, -np.inf
+        return float(np.dot(self.m, z)), float(z.min()), float(z.max())

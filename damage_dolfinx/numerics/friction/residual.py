@@ -30,11 +30,16 @@ class AlgebraicResidual:
         self.b = compat.create_vector(self.l)
         self._v = compat.petsc_vec(problem.v)
         self._work = [self.b.duplicate() for _ in range(3)]  # energy_change: d, s, A d
+        #: callables given b right after l is assembled into it (before the lifting, the ghost
+        #: update and the boundary values), e.g. the contact outputs' reaction rows
+        self.rhs_taps = []
 
     def assemble_rhs(self):
         with self.b.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(self.b, self.l)
+        for tap in self.rhs_taps:
+            tap(self.b)
         compat.apply_lifting(self.b, self.a, self.p.bcs)
         self.b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
         compat.set_bc(self.b, self.p.bcs)
