@@ -67,3 +67,21 @@ def test_list_names_every_example(capsys):
     out = capsys.readouterr().out
     for ex_id in ("2.1-ex1", "2.1-ex2a", "2.1-ex2b"):
         assert ex_id in out
+
+
+def test_singleton_transports_for_mpi_init_only():
+    """A command no MPI launcher started gets Open MPI's singleton transports for MPI_Init
+    only (nothing left in its environment); a value set outside is kept."""
+    import subprocess
+    import sys
+    probe = ("import os, damage_dolfinx.cli as c; "
+             "print(os.environ.get('OMPI_MCA_pml'), os.environ.get('OMPI_MCA_btl'))")
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OMPI_MCA_pml", "OMPI_MCA_btl") and k not in cli._LAUNCHER_VARIABLES}
+    out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["None", "None"]
+    env["OMPI_MCA_pml"] = "ob1"
+    out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["ob1", "None"]

@@ -235,3 +235,36 @@ def test_scalars_equal_assembled_norms():
     st.u.x.array[:] *= 2.0  # a loaded state: M u from u itself
     st.restore(st.n)
     assert st.scalars()["u_L2"] == pytest.approx(norm(ufl.inner(st.u, st.u)), rel=1e-12)
+
+
+def test_elastic_term_one_point_rule_exact():
+    """(zeta Phi_L(B eps(u)), eps(w)) with P1 u, zeta on triangles: the one-point rule the
+    velocity step uses equals degree 4 to round-off, with the truncation active on some cells;
+    a quadrilateral mesh keeps NONLINEAR_DEGREE."""
+    from dolfinx import fem, mesh as dmesh
+    from damage_dolfinx.forms import dynamic_kelvin_voigt as dkv
+    from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress
+    msh = dmesh.create_unit_square(COMM, 6, 5)
+    V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)
+    u, zeta = fem.Function(V), fem.Function(Z)
+    u.interpolate(lambda x: np.vstack((np.sin(3 * x[0]) * x[1], x[0] ** 2 - np.cos(2 * x[1]))))
+    zeta.interpolate(lambda x: 0.2 + 0.7 * x[0] * x[1])
+    assert dkv.elastic_degree(u, zeta) == 1
+    w = ufl.TestFunction(V)
+    term = ufl.inner(damaged_elastic_stress(u, zeta, 1e4, 0.3, 3000.0), eps(w))  # Phi_L clips
+    from petsc4py import PETSc
+    vectors = []
+    for degree in (1, 4):
+        L = compat.form(term * ufl.dx(metadata={"quadrature_degree": degree}))
+        b = compat.create_vector(L)
+        compat.assemble_vector(b, L)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        vectors.append(b.array.copy())
+    assert np.abs(vectors[0] - vectors[1]).max() <= 1e-12 * np.abs(vectors[1]).max()
+    quads = dmesh.create_unit_square(COMM, 2, 2, dmesh.CellType.quadrilateral)
+    Vq, Zq = compat.vector_p1(quads), compat.scalar_p1(quads)
+    assert dkv.elastic_degree(fem.Function(Vq), fem.Function(Zq)) == dkv.NONLINEAR_DEGREE
+    assert compat.dirichlet_values_zero([clamped(V, dmesh.meshtags(msh, 1, np.zeros(0, np.int32),
+                                                                   np.zeros(0, np.int32)), 1)])
+    assert not compat.dirichlet_values_zero([fem.dirichletbc(np.array([0.0, 1.0]),
+                                                             np.array([0], np.int32), V)])

@@ -22,13 +22,42 @@ from __future__ import annotations
 import os
 import sys
 
-from mpi4py import MPI
+#: set by an MPI launcher (Open MPI's mpirun, PMIx, PMI: MPICH's hydra, Slurm's srun) in the
+#: environment of the processes it starts
+_LAUNCHER_VARIABLES = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE")
+#: Open MPI's settings of a process alone: shared memory and TCP only, the pml without UCX
+#: (the values the Makefile gives the tests and demos), and no supporting daemon (orted: a
+#: singleton then cannot spawn processes, which the package never does)
+_SINGLETON_SETTINGS = {"OMPI_MCA_btl": "^ofi,uct", "OMPI_MCA_pml": "ob1",
+                       "OMPI_MCA_ess_singleton_isolated": "1"}
+
+
+def _start_mpi():
+    """MPI_Init (the import of mpi4py.MPI). A command that no MPI launcher started is one rank
+    alone and talks to no other process, yet Open MPI starts a daemon for it and probes every
+    network transport: on Open MPI 4.1 here MPI_Init took 0.38 s, 0.17 s without the probes of
+    libfabric's providers and UCX, 0.05 s without the daemon (the probes take about 1 s under
+    Open MPI 6). Such a process starts with _SINGLETON_SETTINGS, for MPI_Init only: a value
+    set outside is kept, and the variables are taken out again (a process it starts does not
+    inherit them). Other MPI libraries ignore them."""
+    added = {} if any(v in os.environ for v in _LAUNCHER_VARIABLES) else \
+        {k: v for k, v in _SINGLETON_SETTINGS.items() if k not in os.environ}
+    os.environ.update(added)
+    try:
+        from mpi4py import MPI  # noqa: F401  (MPI_Init)
+    finally:
+        for key in added:
+            os.environ.pop(key, None)
+
+
+_start_mpi()
+from mpi4py import MPI  # noqa: E402
 
 # the parts, by concept: the arguments (arguments.py), the PETSc options among them
 # (petsc_options.py), what each command does (commands.py); these names are their public face
-from damage_dolfinx.cli.commands import command
-from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser  # noqa: F401
-from damage_dolfinx.cli.petsc_options import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401
+from damage_dolfinx.cli.commands import command  # noqa: E402
+from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser  # noqa: F401,E402
+from damage_dolfinx.cli.petsc_options import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401,E402
                                               _check_petsc_values, _forget, _petsc_options,
                                               _unused)
 

@@ -35,12 +35,12 @@ DOLFINX_VERSION = dolfinx.__version__
 ScalarType = getattr(dolfinx, "default_scalar_type", PETSc.ScalarType)
 
 from damage_dolfinx.compat.spaces import (  # noqa: E402,F401
-    function_space, element_degree, is_discontinuous, scalar_p1, vector_p1,
+    function_space, element_degree, affine_simplex, is_discontinuous, scalar_p1, vector_p1,
     scalar_dg0, tensor_dg0, facet_vertex_quadrature, interpolation_points, expression,
     eval_expression, interpolate, locate_points)
 from damage_dolfinx.compat.assembly import (  # noqa: E402,F401
     petsc_vec, create_vector, create_matrix, assemble_vector, assemble_vector_array,
-    assemble_matrix, apply_lifting, set_bc, form, assemble_scalar,
+    assemble_matrix, apply_lifting, dirichlet_values_zero, set_bc, form, assemble_scalar,
     bc_dofs)
 from damage_dolfinx.compat.meshes import (  # noqa: E402,F401
     create_rectangle, create_box, create_simplex_mesh, create_tet_mesh, create_submesh,

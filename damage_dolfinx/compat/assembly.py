@@ -57,6 +57,28 @@ def apply_lifting(b, a_form, bcs, x0=None, scale=1.0):
                             **{_SCALE_KEY: scale})
 
 
+def dirichlet_values_zero(bcs) -> bool:
+    """True when every condition's value is known to be zero (a Constant, an array or a
+    Function with only zeros): the lifting b -= A (g - x0) with x0 = 0 then changes nothing.
+    The value is ``bc.g`` (0.5+: the given value; 0.9+: the wrapped Constant or Function),
+    ``bc.value`` where there is no ``g``; anything else counts as non-zero."""
+    for bc in bcs:
+        g = getattr(bc, "g", None)
+        if g is None:
+            g = getattr(bc, "value", None)
+        if isinstance(g, np.ndarray):
+            values = g
+        elif hasattr(g, "x") and hasattr(g.x, "array"):  # a Function
+            values = g.x.array
+        elif isinstance(getattr(g, "value", None), (np.ndarray, float, int)):  # a Constant
+            values = np.asarray(g.value)
+        else:
+            return False
+        if values.dtype.kind not in "fciu" or np.any(values != 0):
+            return False
+    return True
+
+
 def set_bc(b, bcs, x0=None, scale=1.0):
     fem.petsc.set_bc(b, bcs, x0, **{_SCALE_KEY: scale})
 

@@ -29,6 +29,16 @@ def element_degree(V) -> int:
     return int(d() if callable(d) else d)
 
 
+def affine_simplex(msh) -> bool:
+    """True when the mesh's cells are simplices with an affine (degree 1) coordinate map, so
+    that gradients of P1 functions are constant on each cell (UFL's own test; False where it
+    cannot tell)."""
+    try:
+        return bool(msh.ufl_domain().is_piecewise_linear_simplex_domain())
+    except (AttributeError, TypeError):
+        return False
+
+
 def is_discontinuous(V) -> bool:
     """True for DG spaces (legacy UFL: family 'Discontinuous Lagrange'; basix.ufl: a flag)."""
     e = V.ufl_element()

@@ -40,7 +40,11 @@ def norm_matrix(a_form, block_size: int) -> PETSc.Mat:
     A = compat.create_matrix(a_form, "baij" if block_size > 1 else None)
     compat.assemble_matrix(A, a_form, [])
     A.assemble()
-    return A.convert("sbaij") if block_size > 1 else A
+    if block_size == 1:
+        return A
+    # symmetric by construction; newer PETSc refuses the conversion unless the matrix says so
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    return A.convert("sbaij")
 
 
 def norm_operators(V, Z) -> tuple:

@@ -80,9 +80,11 @@ def boundary_edges(xy):
     return edges[order[single]]
 
 
-def draw_outline(ax, ref_xy, label="undeformed outline"):
+def draw_outline(ax, ref_xy, label="undeformed outline", edges=None):
+    """The outline of ``ref_xy`` (``edges``: its boundary_edges, when already computed)."""
     from matplotlib.collections import LineCollection
-    ax.add_collection(LineCollection(boundary_edges(ref_xy), colors="tab:red", linewidths=0.8,
+    edges = boundary_edges(ref_xy) if edges is None else edges
+    ax.add_collection(LineCollection(edges, colors="tab:red", linewidths=0.8,
                                      linestyles="--", label=label, zorder=3))
 
 

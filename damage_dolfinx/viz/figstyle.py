@@ -124,6 +124,7 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
     panels, amplification, replaced = readable(panels, ref_xy, amplification)
     nplot = len(panels) if not mesh_only or all("title" in p for p in panels) else 1
     allxy = [p["xy"] for p in panels] + ([ref_xy] if ref_xy is not None else [])
+    outline = boundary_edges(np.asarray(ref_xy)) if ref_xy is not None else None  # once
     extra = 0 if mesh_only or zeta_star is None else sum(
         is_damage(p.get("name", ""), p.get("label", ""))
         and narrow_damage(float(np.nanmin(p["values"])), float(np.nanmax(p["values"])), zeta_star)
@@ -169,14 +170,14 @@ def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_s
                 ax.set_title(p.get("title", re.sub(r"\s*\[[^]]*\]$", "", label)))
             used.append((vmin, vmax))
         if ref_xy is not None:
-            draw_outline(ax, np.asarray(ref_xy))
+            draw_outline(ax, None, edges=outline)
         draw_guides(ax, guides, xy, ref_xy)
         _frame(ax, [xy] + ([ref_xy] if ref_xy is not None else [])
                + [np.asarray(g["line"], float) for g in guides or () if "line" in g])
     for ax, (src, tri, vals, lo, hi) in zip(axes[nplot:], stretched):
         _stretched_damage(fig, ax, tri, vals, lo, hi)
         if ref_xy is not None:
-            draw_outline(ax, np.asarray(ref_xy))
+            draw_outline(ax, None, edges=outline)
         ax.set_xlim(src.get_xlim())
         ax.set_ylim(src.get_ylim())
         ax.set_aspect("equal")

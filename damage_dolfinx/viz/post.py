@@ -287,14 +287,48 @@ def setting_loads(stepper, samples=40):
     return out
 
 
+def _pointwise(expr):
+    """(x, mapping, i) -> float(expr[i](x, mapping)): UFL's own pointwise evaluation, with its
+    expansion of derivatives done once instead of at each call (most of a call's time; the
+    setting figure makes 40 sample times x a dozen points x 2 components of them). The first
+    value is computed both ways; UFL's call is kept where they differ (another UFL's
+    internals)."""
+    def slow(x, mapping, i):
+        return float(expr[i](x, mapping))
+    try:
+        from ufl.algorithms import expand_derivatives
+        from ufl.utils.stacks import StackDict
+        expanded = expand_derivatives(expr)
+    except (ImportError, AttributeError):
+        return slow
+
+    def fast(x, mapping, i):
+        return float(expanded.evaluate(x, mapping, (i,), StackDict()))
+    chosen = []
+
+    def component(x, mapping, i):
+        if chosen:
+            return chosen[0](x, mapping, i)
+        value = slow(x, mapping, i)
+        try:
+            same = fast(x, mapping, i) == value
+        except Exception:  # noqa: BLE001 - internals of another UFL version
+            same = False
+        chosen.append(fast if same else slow)
+        return value
+    return component
+
+
 def _strongest_load(expr, constants, t_const, times, points):
     """(t, values (npts, 2)) of the UFL vector ``expr`` at ``points`` for the time of
     ``times`` where its largest value is largest (t = "constant" if that never changes);
     (None, None) if it vanishes throughout."""
+    component = _pointwise(expr)
+
     def values(t, pts):
         mapping = {c: (float(t) if c is t_const else (v if v.shape else float(v)))
                    for c, v in constants.items()}
-        return np.array([[float(expr[i](tuple(p), mapping)) for i in range(2)] for p in pts])
+        return np.array([[component(tuple(p), mapping, i) for i in range(2)] for p in pts])
 
     probe = points[::max(1, len(points) // 12)]  # the time is chosen on a dozen points
     peaks = [float(np.max(np.linalg.norm(values(t, probe), axis=1))) if len(probe) else 0.0
