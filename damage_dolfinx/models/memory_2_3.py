@@ -192,6 +192,10 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
     def update_output(self):
         compat.interpolate(self.von_mises, self._vm_expr)
 
+    def track(self):
+        """Between history rows (--history-every): nothing to do, scalars() keeps no running
+        values (the run's state check still runs every step)."""
+
     def scalars(self) -> dict:
         """Base scalars, the RMS penetration (u.nu - gap)_+ over Gamma_C and ||sigma_n||_Q
         (per cell without an assembly where bookkeeping.AffineStressNorm applies: exact)."""
