@@ -107,6 +107,18 @@ def test_example3_fading_memory_and_residual_stress(tmp_path):
     assert s1 > 1e-4 * s_half
 
 
+def _split_test_model():
+    """(model, geometry): a 2.3 model on a 6 x 6 unit square, clamped on top, Gamma_C at the
+    bottom, constant memory kernel (the set-up of the split tests)."""
+    params = ModelParameters(E=100.0, nu=0.3, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,
+                             stop_at_zeta_star=False,
+                             extra={"c_nu": 1e3, "gap": 0.0, "memory_kernel": "constant"})
+    geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 6, 6,
+                    {GAMMA_D: side(1, 1.0), GAMMA_C: side(1, 0.0)})
+    return ViscoelasticMemoryContact(Problem("2.3", geo, 1.0, k=1.0, params=params,
+                                             name="split-test")), geo
+
+
 def test_split_jacobian_equals_assembly():
     """The 2.3 Jacobian split (constant cell part once, Gamma_C term per Newton step)
     equals the full assembly, Dirichlet rows included, at a state in contact on part of Gamma_C;
@@ -116,12 +128,7 @@ def test_split_jacobian_equals_assembly():
     from damage_dolfinx.numerics.callbacks import constant_cell_jacobian, form_callbacks, relative_change
     from damage_dolfinx.forms.viscoelastic_memory import displacement_residual
     from damage_dolfinx.geometries import GAMMA_N
-    params = ModelParameters(E=100.0, nu=0.3, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,
-                             stop_at_zeta_star=False,
-                             extra={"c_nu": 1e3, "gap": 0.0, "memory_kernel": "constant"})
-    geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 6, 6,
-                    {GAMMA_D: side(1, 1.0), GAMMA_C: side(1, 0.0)})
-    s = ViscoelasticMemoryContact(Problem("2.3", geo, 1.0, k=1.0, params=params, name="split-test"))
+    s, geo = _split_test_model()
     V = s.u.function_space
     X = V.tabulate_dof_coordinates()
     s.u.x.array.reshape(-1, 2)[:, 1] = -0.01 * np.sin(7.0 * X[:, 0])  # contact where < 0
@@ -153,12 +160,7 @@ def test_split_residual_and_jacobian_key():
     Jacobian) is unchanged while the contact set is and changes with it."""
     from damage_dolfinx import compat
     from damage_dolfinx.numerics.split_residual import SplitResidual
-    params = ModelParameters(E=100.0, nu=0.3, variant="A", lam_D=0.0, lam_u=0.0, kappa=1.0,
-                             stop_at_zeta_star=False,
-                             extra={"c_nu": 1e3, "gap": 0.0, "memory_kernel": "constant"})
-    geo = rectangle(MPI.COMM_WORLD, (0, 0), (1, 1), 6, 6,
-                    {GAMMA_D: side(1, 1.0), GAMMA_C: side(1, 0.0)})
-    s = ViscoelasticMemoryContact(Problem("2.3", geo, 1.0, k=1.0, params=params, name="split-test"))
+    s, _ = _split_test_model()
     assert isinstance(s._residual, SplitResidual)
     rng = np.random.default_rng(3)
     s.memory.M.x.array[:] = rng.standard_normal(s.memory.M.x.array.size)
