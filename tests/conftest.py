@@ -27,6 +27,15 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
                os.environ.get("PYTHONPATH")])))
 
 
+
+def tool_lines(stderr):
+    """The lines of ``stderr`` that the package printed ("damage-dolfinx: ..."). Open MPI 5's
+    launcher (PRRTE 3.0.8 in Debian 13) ends its own help messages (the MPI_ABORT notice) with a
+    NUL byte, which then precedes whatever line a rank prints next: it is removed first."""
+    return [line for line in stderr.replace("\0", "").splitlines()
+            if line.startswith("damage-dolfinx:")]
+
+
 def run_cli(args, np_=1, check=True, timeout=600):
     """Run `damage-dolfinx ARGS` (under mpirun -n np_ if np_ > 1); returns CompletedProcess."""
     cmd = [sys.executable, "-m", "damage_dolfinx.cli", *map(str, args)]

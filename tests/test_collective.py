@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ENV
+from conftest import ENV, tool_lines
 
 SCRIPT = textwrap.dedent('''
     import sys
@@ -68,7 +68,7 @@ def test_user_code_failing_on_rank_1_only_ends_every_rank(tmp_path, ranks, where
     proc, seconds = _mpirun(ranks, [sys.executable, str(script), str(out), where])
     assert seconds < 30, (seconds, proc.stderr)
     assert proc.returncode in (2, 3), proc.stderr
-    lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    lines = tool_lines(proc.stderr)
     assert len(lines) == 1 and "rank 1" in lines[0], proc.stderr
     assert "Traceback" not in proc.stderr
     if (out / "summary.json").exists():
@@ -83,7 +83,7 @@ def test_sweep_refusal_on_one_point_is_collective(tmp_path):
                                 "--set", "kappa=0.5,1", "--n", "5", "--T", "0.02", "--out",
                                 str(out), "--no-figures", "--quiet"])
     assert seconds < 30 and proc.returncode == 2, proc.stderr
-    lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    lines = tool_lines(proc.stderr)
     assert len(lines) == 1 and "point_1" in lines[0], proc.stderr
     assert (out / "point_1" / "notes.txt").read_text() == "mine"
     assert not (out / "point_0").exists()
@@ -119,7 +119,7 @@ def test_sigterm_to_one_rank_of_a_sweep_ends_every_rank(tmp_path):
     for i in (0, 1):
         assert json.loads((out / f"point_{i}" / "summary.json").read_text())["status"] == \
             "interrupted"
-    lines = [line for line in stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    lines = tool_lines(stderr)
     assert len(lines) == 1 and "SIGTERM" in lines[0], stderr
     assert "MPI_ABORT" not in stderr and "job aborted" not in stderr, stderr
 

@@ -16,7 +16,7 @@ import time
 import numpy as np
 import pytest
 
-from conftest import ENV, load_run, rel_diff, run_cli
+from conftest import ENV, load_run, rel_diff, run_cli, tool_lines
 from damage_dolfinx.runtime import atomic, io
 from damage_dolfinx import cli
 
@@ -209,7 +209,7 @@ def test_output_folder_deleted_mid_run(tmp_path, np_):
         shutil.rmtree(out, ignore_errors=True)
     _, err = proc.communicate(timeout=900)  # the next write fails: seconds, more when loaded
     assert proc.returncode == 4, err
-    ours = [line for line in err.splitlines() if line.startswith("damage-dolfinx:")]
+    ours = tool_lines(err)
     assert len(ours) == 1 and "Traceback" not in err, err
     # the reason: the file or folder missing; or, when the write falls inside the removal (its
     # file already gone, the folder not yet), HDF5's own failure to open the file it appends to
@@ -243,7 +243,7 @@ def test_signal_writes_a_checkpoint_and_marks_the_summary(tmp_path, sig, np_):
         time.sleep(0.05)
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 128 + sig, err
-    ours = [line for line in err.splitlines() if line.startswith("damage-dolfinx:")]
+    ours = tool_lines(err)
     assert len(ours) == 1 and f"stopped by {signal.Signals(sig).name} after step" in ours[0]
     assert "Traceback" not in err
     summary = json.loads((out / "summary.json").read_text())

@@ -11,7 +11,7 @@ import textwrap
 
 import pytest
 
-from conftest import ENV
+from conftest import ENV, tool_lines
 
 SCRIPT = textwrap.dedent('''
     import json, sys
@@ -115,7 +115,7 @@ def test_restart_on_1_2_3_ranks_with_other_hash_seeds_is_accepted(tmp_path):
                           ("zeta0", "the initial damage zeta0 changed")):
         proc = _python(tmp_path, 2, 3, "restart", out, 0.08, 1, variant)
         assert proc.returncode == 2, proc.stderr
-        lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+        lines = tool_lines(proc.stderr)
         assert len(lines) == 1 and item in lines[0] and "Traceback" not in proc.stderr, \
             proc.stderr
     assert json.loads((out / "summary.json").read_text())["steps_done"] == 6

@@ -10,7 +10,7 @@ import time
 import pytest
 
 import damage_dolfinx as dd
-from conftest import ENV
+from conftest import ENV, tool_lines
 
 CASE = dict(n=5, k=0.25, T=1.0, progress=False, figures=False)
 
@@ -80,7 +80,7 @@ def test_a_raise_on_rank_1_only_in_the_with_body_ends_both_ranks(tmp_path):
                           capture_output=True, text=True, env=ENV, timeout=60)
     assert time.monotonic() - start < 30, proc.stderr
     assert proc.returncode == 3, proc.stderr
-    lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    lines = tool_lines(proc.stderr)
     assert len(lines) == 1 and "rank 1" in lines[0] and "RuntimeError" in lines[0], proc.stderr
     s = summary(out)
     assert s["status"] == "failed" and "RuntimeError" in s["error"], s

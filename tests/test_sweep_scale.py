@@ -13,7 +13,7 @@ import time
 
 import pytest
 
-from conftest import ENV
+from conftest import ENV, tool_lines
 
 CLI = [sys.executable, "-m", "damage_dolfinx.cli"]
 TINY = ["sweep", "2.2-ex1", "--n", "4", "--T", "0.04", "--k", "0.01", "--no-figures", "--quiet",
@@ -79,6 +79,48 @@ def test_groups_of_ranks_give_the_serial_table(tmp_path, serial, ranks, per_poin
             per_point
 
 
+OPENER = textwrap.dedent("""
+    import sys, time
+    from pathlib import Path
+    from mpi4py import MPI
+    from damage_dolfinx.studies.sweep_folder import open_sweep
+    root, point, start, rounds = Path(sys.argv[1]), int(sys.argv[2]), float(sys.argv[3]), \\
+        int(sys.argv[4])
+    mapping = {"schema": "damage-dolfinx/sweep/v1", "case": "2.2-ex1",
+               "grid": {"kappa": [1, 2, 3, 4]}, "n": 4, "k": 0.01, "T": 0.04,
+               "points": [{"index": i, "folder": f"point_{i}", "values": {"kappa": i + 1}}
+                          for i in range(4)]}
+    for j in range(rounds):  # the jobs open folder s<j> at the same instant
+        out = root / f"s{j}"
+        out.mkdir(exist_ok=True)
+        while time.time() < start + 0.05 * j:
+            time.sleep(0.0005)
+        try:
+            open_sweep(out, mapping, point, MPI.COMM_SELF)
+            (out / f"point_{point}").mkdir(exist_ok=True)  # its run starts
+        except Exception as exc:
+            print(f"folder s{j}: {type(exc).__name__}: {exc}", file=sys.stderr)
+""")
+
+
+def test_point_jobs_opening_one_folder_at_the_same_instant_never_refuse(tmp_path):
+    """The opening of a sweep folder by the jobs of a job array, without solving: 4 jobs open
+    each of 40 fresh folders at the same instant; none is refused or fails (one job, half-way
+    through writing the folder, once made another's check fail with a KeyError)."""
+    script = tmp_path / "opener.py"
+    script.write_text(OPENER)
+    start = time.time() + 4.0  # after the imports of every job
+    jobs = [subprocess.Popen([sys.executable, str(script), str(tmp_path), str(i), str(start),
+                              "40"], stderr=subprocess.PIPE, text=True, env=ENV)
+            for i in range(4)]
+    errors = [job.communicate(timeout=120)[1] for job in jobs]
+    assert all(job.returncode == 0 for job in jobs), errors
+    assert not any(errors), errors
+    for j in range(40):
+        manifest = json.loads((tmp_path / f"s{j}" / "manifest.json").read_text())
+        assert manifest["kind"] == "sweep" and {"points.json", "point_0"} <= set(manifest["files"])
+        assert all((tmp_path / f"s{j}" / f"point_{i}").is_dir() for i in range(4))
+
 def test_job_array_of_four_concurrent_point_jobs_gives_the_serial_table(tmp_path, serial):
     out = tmp_path / "sweep"
     jobs = [subprocess.Popen(CLI + TINY + ["--point", str(i), "--out", str(out)],
@@ -135,7 +177,7 @@ def test_ranks_per_point_not_dividing_the_ranks_is_refused_on_every_rank(tmp_pat
     out = tmp_path / "sweep"
     r = cli(*TINY, "--ranks-per-point", 3, "--out", out, np_=2)
     assert r.returncode == 2, r.stderr
-    lines = [line for line in r.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    lines = tool_lines(r.stderr)
     assert len(lines) == 1 and "3 ranks per point do not divide the 2 rank(s)" in lines[0]
     assert not out.exists()
 
@@ -199,7 +241,7 @@ def _script(tmp_path, where, timeout=120):
     proc = subprocess.run(["mpirun", "-n", "4", "--oversubscribe", sys.executable, str(script),
                            str(out), where], capture_output=True, text=True, env=ENV,
                           timeout=timeout)
-    lines = [line for line in proc.stderr.splitlines() if line.startswith("damage-dolfinx:")]
+    lines = tool_lines(proc.stderr)
     return proc, lines, out, time.monotonic() - start
 
 

@@ -61,8 +61,15 @@ def open_sweep(out, mapping, point, comm) -> list:
     may be written by other jobs at this moment)."""
     from damage_dolfinx.runtime import runfolder
     # the checks first without the lock, so that a refused folder does not receive a lock file;
-    # then again under it (another process may have written the folder in between)
-    runfolder.decided(comm, out, _open, Path(out), mapping, point, False)
+    # then again under it (another process may have written the folder in between). A refusal
+    # of the first pass in a folder that already has the lock file may have seen another job of
+    # the sweep half-way through opening it: it is decided again under the lock.
+    try:
+        runfolder.decided(comm, out, _open, Path(out), mapping, point, False)
+    except InputError:
+        shared = comm.bcast((Path(out) / ".sweep.lock").is_file() if comm.rank == 0 else None)
+        if not shared:
+            raise
     with runfolder.shared_folder_lock(out, comm):
         return runfolder.decided(comm, out, _open, Path(out), mapping, point, True)
 
@@ -109,6 +116,10 @@ def _read_summary(out: Path) -> dict:
 def _claim_sweep(out: Path, count: int, point, apply=True) -> list:
     from damage_dolfinx.runtime import runfolder
     names = {f"point_{i}" for i in range(count)} | set(SWEEP_FILES)
+    # one snapshot, in this order: the names present, then the manifest once. Another job of
+    # the sweep writes the manifest before any other file of the sweep, so whatever it wrote by
+    # the listing is named in the manifest read after it (reading the manifest twice could see
+    # none, then one)
     present = {p.name for p in out.iterdir()}
     known = runfolder.read_manifest(out)
     if known is not None and known[0] != "sweep":
@@ -116,9 +127,9 @@ def _claim_sweep(out: Path, count: int, point, apply=True) -> list:
         raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
                          "choose another --out (nothing was touched)")
     if known is None:
-        legacy = runfolder.folder_contents(out)[0]
+        legacy = runfolder._legacy(out)  # a run or a study written before manifests
         if legacy is not None:
-            what = {"run": "a run", "study": "a convergence study"}[legacy]
+            what = {"run": "a run", "study": "a convergence study"}[legacy[0]]
             raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
                              "choose another --out (nothing was touched)")
         ours = set() if "points.json" not in present else \
