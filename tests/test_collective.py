@@ -91,9 +91,12 @@ def test_sweep_refusal_on_one_point_is_collective(tmp_path):
 
 def test_sigterm_to_one_rank_of_a_sweep_ends_every_rank(tmp_path):
     out = tmp_path / "sw"
+    # each point runs for seconds (about 8000 steps before zeta* is reached), so that rank 0's
+    # point is still running when rank 1's notice comes: at k = 0.01 it ended in 0.3 s, at
+    # times before the notice (it is then "completed", as it should be)
     cmd = ["mpirun", "-n", "2", sys.executable, "-m", "damage_dolfinx.cli", "sweep", "2.1-ex1",
            "--set", "kappa=0.5,1", "--set", "lam_u_plus=1", "--n", "10", "--T", "5",
-           "--out", str(out),
+           "--k", "0.0005", "--out", str(out),
            "--no-figures"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=ENV)
