@@ -27,7 +27,6 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
                os.environ.get("PYTHONPATH")])))
 
 
-
 def tool_lines(stderr):
     """The lines of ``stderr`` that the package printed ("damage-dolfinx: ..."). Open MPI 5's
     launcher (PRRTE 3.0.8 in Debian 13) ends its own help messages (the MPI_ABORT notice) with a

@@ -122,16 +122,13 @@ def _claim_sweep(out: Path, count: int, point, apply=True) -> list:
     # none, then one)
     present = {p.name for p in out.iterdir()}
     known = runfolder.read_manifest(out)
-    if known is not None and known[0] != "sweep":
-        what = {"run": "a run", "study": "a convergence study"}[known[0]]
+    # without a manifest: a run or a study written before manifests, told by its summary alone
+    found = known[0] if known is not None else (runfolder._legacy(out) or (None,))[0]
+    if found in ("run", "study"):
+        what = {"run": "a run", "study": "a convergence study"}[found]
         raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
                          "choose another --out (nothing was touched)")
     if known is None:
-        legacy = runfolder._legacy(out)  # a run or a study written before manifests
-        if legacy is not None:
-            what = {"run": "a run", "study": "a convergence study"}[legacy[0]]
-            raise InputError(f"{str(out)!r} holds {what}; a sweep needs a folder of its own: "
-                             "choose another --out (nothing was touched)")
         ours = set() if "points.json" not in present else \
             {n for n in present if n in names}  # a sweep written before manifests
     else:
