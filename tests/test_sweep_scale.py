@@ -121,6 +121,7 @@ def test_point_jobs_opening_one_folder_at_the_same_instant_never_refuse(tmp_path
         assert manifest["kind"] == "sweep" and {"points.json", "point_0"} <= set(manifest["files"])
         assert all((tmp_path / f"s{j}" / f"point_{i}").is_dir() for i in range(4))
 
+
 def test_job_array_of_four_concurrent_point_jobs_gives_the_serial_table(tmp_path, serial):
     out = tmp_path / "sweep"
     jobs = [subprocess.Popen(CLI + TINY + ["--point", str(i), "--out", str(out)],

@@ -97,13 +97,13 @@ class RunLock:
 
 
 @contextlib.contextmanager
-def shared_folder_lock(out, comm, name=".sweep.lock"):
-    """Hold ``out/name`` locked (rank 0, flock; lockf where the file system has no flock) for
-    the body: separate processes writing the same folder (the jobs of a job array, each
+def shared_folder_lock(out, comm):
+    """Hold ``out/.sweep.lock`` (SWEEP_LOCK) locked (rank 0, flock; lockf where the file
+    system has no flock) for the body: separate processes writing the same folder (the jobs of a job array, each
     running points of one sweep) take turns there. Waits for the holder; the kernel drops a
     dead holder's lock. The file stays (never unlinked, so no two holders can ever hold two
     different files)."""
-    fd, error = None, None
+    fd, error, name = None, None, SWEEP_LOCK
     if comm.rank == 0:
         try:
             fd = os.open(Path(out) / name, os.O_RDWR | os.O_CREAT, 0o644)
@@ -190,6 +190,8 @@ MANIFEST = "manifest.json"
 MANIFEST_SCHEMA = "damage-dolfinx/manifest/v1"
 #: names the package uses for its own bookkeeping (a run's lock, a sweep folder's lock)
 HIDDEN = (".lock", ".sweep.lock")
+#: the lock file of a folder shared by separate processes (a sweep's jobs): shared_folder_lock
+SWEEP_LOCK = HIDDEN[1]
 #: the writability probe of io.prepare_output_dir (PROBE + pid, there for an instant)
 PROBE = ".damage-dolfinx-write-test-"
 #: files of a convergence study

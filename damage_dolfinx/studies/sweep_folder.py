@@ -67,7 +67,8 @@ def open_sweep(out, mapping, point, comm) -> list:
     try:
         runfolder.decided(comm, out, _open, Path(out), mapping, point, False)
     except InputError:
-        shared = comm.bcast((Path(out) / ".sweep.lock").is_file() if comm.rank == 0 else None)
+        shared = comm.bcast((Path(out) / runfolder.SWEEP_LOCK).is_file() if comm.rank == 0
+                            else None)
         if not shared:
             raise
     with runfolder.shared_folder_lock(out, comm):
