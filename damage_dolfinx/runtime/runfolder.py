@@ -100,9 +100,9 @@ class RunLock:
 def shared_folder_lock(out, comm):
     """Hold ``out/.sweep.lock`` (SWEEP_LOCK) locked (rank 0, flock; lockf where the file
     system has no flock) for the body: separate processes writing the same folder (the jobs
-    of a job array, each running points of one sweep) take turns there. Waits for the holder; the kernel drops a
-    dead holder's lock. The file stays (never unlinked, so no two holders can ever hold two
-    different files)."""
+    of a job array, each running points of one sweep) take turns there. Waits for the holder;
+    the kernel drops a dead holder's lock. The file stays (never unlinked, so no two holders
+    can ever hold two different files)."""
     fd, error, name = None, None, SWEEP_LOCK
     if comm.rank == 0:
         try:
