@@ -9,7 +9,7 @@ The public face (everything else is internal and may change):
   rank 0; :func:`steps`: the same run step by step in your script (the live Functions, your
   monitors, a stop on your criterion);
 * :class:`Model` (the base of every model: a model of your own derives from it, from the
-  building blocks of :mod:`damage_dolfinx.blocks`), :class:`SubStep`
+  building blocks of :mod:`damage_dolfinx.models.blocks`), :class:`SubStep`
   (a model is built from a :class:`Problem` whose mesh is built), :func:`register_model`,
   :func:`model_class` (a model's class by id);
 * :class:`DamageLaw` and the thesis laws :data:`THESIS_A`, :data:`THESIS_B`;
@@ -19,26 +19,27 @@ The public face (everything else is internal and may change):
 * :class:`ModelParameters` (material, damage and model data);
 * the exceptions :class:`InputError` (bad input, refused before any work),
   :class:`ConvergenceError` (a solver failed), :class:`OutputError` (an output could not be
-  written), :class:`RunInterrupted` (stopped by a signal, with a checkpoint): damage_dolfinx.errors;
+  written), :class:`RunInterrupted` (stopped by a signal, with a checkpoint): damage_dolfinx.core.errors;
 * the packages :mod:`damage_dolfinx.geometries` (mesh builders) and :mod:`damage_dolfinx.forms`
   (the weak forms in UFL).
 
 Names are imported on first use, so ``import damage_dolfinx`` stays light.
 """
-__version__ = "0.1.0"
+from damage_dolfinx.core.version import __version__  # noqa: F401
 
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
            "Model", "SubStep", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
            "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run"]
 
-_WHERE = {"Problem": "problem", "run": "workflow", "steps": "workflow", "Model": "models.base",
-          "SubStep": "models.base", "converge": "workflow",
-          "sweep": "workflow", "gather": "workflow", "DamageLaw": "laws", "THESIS_A": "laws",
-          "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
-          "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results",
-          "ConvergenceError": "numerics.solvers", "OutputError": "runtime.atomic",
-          "RunInterrupted": "runtime.signals"}
+_WHERE = {"Problem": "problem.problem", "run": "api.workflow", "steps": "api.workflow",
+          "Model": "models.base", "SubStep": "models.base", "converge": "api.workflow",
+          "sweep": "api.workflow", "gather": "api.workflow", "DamageLaw": "models.laws",
+          "THESIS_A": "models.laws", "THESIS_B": "models.laws", "read_mesh": "problem.meshes",
+          "from_gmsh": "problem.meshes", "ModelParameters": "core.parameters",
+          "InputError": "core.errors", "read_run": "api.results",
+          "ConvergenceError": "core.errors", "OutputError": "core.errors",
+          "RunInterrupted": "core.errors"}
 
 
 def __getattr__(name):
@@ -49,7 +50,7 @@ def __getattr__(name):
         from damage_dolfinx.models.registry import MODELS
         return {key: m.title for key, m in MODELS.items()}
     if name == "blocks":  # the building blocks of the models (a module)
-        return importlib.import_module("damage_dolfinx.blocks")
+        return importlib.import_module("damage_dolfinx.models.blocks")
     if name == "register_model":
         from damage_dolfinx.models.registry import register
         return register
@@ -61,6 +62,46 @@ def __getattr__(name):
         return default_parameters
     raise AttributeError(f"module 'damage_dolfinx' has no attribute {name!r}")
 
+
+
+#: modules of earlier releases, by their old names: importing one still works, with a warning
+_MOVED = {"blocks": "models.blocks", "errors": "core.errors", "laws": "models.laws",
+          "parameters": "core.parameters", "results": "api.results",
+          "workflow": "api.workflow", "meshes": "problem.meshes"}
+
+
+class _MovedModules:
+    """Import finder of the old module names (``damage_dolfinx.blocks`` ...): the module under
+    its new name, with a DeprecationWarning naming it."""
+
+    @staticmethod
+    def find_spec(fullname, path=None, target=None):
+        prefix, _, rest = fullname.partition(".")
+        if prefix != "damage_dolfinx" or rest not in _MOVED:
+            return None
+        import importlib.util
+        return importlib.util.spec_from_loader(fullname, _MovedModules)
+
+    @staticmethod
+    def create_module(spec):
+        import importlib
+        import warnings
+        new = f"damage_dolfinx.{_MOVED[spec.name.partition('.')[2]]}"
+        warnings.warn(f"{spec.name} is now {new}", DeprecationWarning, stacklevel=3)
+        return importlib.import_module(new)
+
+    @staticmethod
+    def exec_module(module):
+        pass
+
+
+def _install_moved_modules():
+    import sys
+    if not any(finder is _MovedModules for finder in sys.meta_path):
+        sys.meta_path.append(_MovedModules)
+
+
+_install_moved_modules()
 
 def __dir__():
     return sorted(list(globals()) + __all__)

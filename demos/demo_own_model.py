@@ -4,7 +4,7 @@ Your own model: Kelvin-Voigt with normal compliance
 
 A model is one class: it declares what it is (id, contact roles, checkpointed fields, history
 columns, sub-steps, explicit update, stability limit, default data) and builds its unknowns and
-solvers from the public building blocks of :mod:`damage_dolfinx.blocks`; the step itself is the
+solvers from the public building blocks of :mod:`damage_dolfinx.models.blocks`; the step itself is the
 package's (old state copied, sub-steps in order, explicit update). Here model 2.2 (quasistatic
 Kelvin-Voigt body with damage) with the Tresca friction of its contact boundary replaced by
 normal compliance :math:`p_\nu(r) = c_\nu r_+`, written in this script, without touching the

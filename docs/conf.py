@@ -61,7 +61,7 @@ autodoc_member_order = "bysource"
 autodoc_typehints = "description"
 autodoc_typehints_description_target = "documented"  # no lists of undocumented parameters
 # the source pages link back to where an object is documented under its own module; a name
-# re-exported at the top level or by damage_dolfinx.blocks gets no back-link (viewcode keeps one
+# re-exported at the top level or by damage_dolfinx.models.blocks gets no back-link (viewcode keeps one
 # documenting module per source module, and would link the others to missing anchors)
 viewcode_follow_imported_members = False
 autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": True}

@@ -17,8 +17,8 @@ contact term's positive part is not polynomial on a facet: NONLINEAR_DEGREE alwa
 import ufl
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics.constitutive import eps
-from damage_dolfinx.numerics.contact import normal_compliance_pressure
+from damage_dolfinx.forms.constitutive import eps
+from damage_dolfinx.forms.contact import normal_compliance_pressure
 
 from damage_dolfinx.forms.elastic_damage import load
 from damage_dolfinx.forms.kelvin_voigt import damaged_elastic_stress, kelvin_voigt_stress, viscous_stress

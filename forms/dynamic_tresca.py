@@ -10,7 +10,7 @@ Written as the second-kind VI a(v, w - v) + j(w) - j(v) >= l(w - v) that
 """
 import ufl
 
-from damage_dolfinx.numerics.constitutive import B, Phi_L, eps, eta_star
+from damage_dolfinx.forms.constitutive import B, Phi_L, eps, eta_star
 
 from damage_dolfinx.forms.elastic_damage import load
 from damage_dolfinx.forms.kelvin_voigt import viscous_stress

@@ -5,7 +5,7 @@ L_n(w) = (f_B(t_n), w) + (f_N(t_n), w)_{Gamma_N}.
 """
 import ufl
 
-from damage_dolfinx.numerics.constitutive import B, eps, eta_star
+from damage_dolfinx.forms.constitutive import B, eps, eta_star
 
 
 def stress(u, zeta, E, nu, zeta_star):

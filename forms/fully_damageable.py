@@ -15,8 +15,8 @@ fast qualitative runs only; the step is then nonlinear (semismooth in the contac
 returned as a residual. """
 import ufl
 
-from damage_dolfinx.numerics.constitutive import B, Phi_L, eps, eta_star
-from damage_dolfinx.numerics.contact import positive_part
+from damage_dolfinx.forms.constitutive import B, Phi_L, eps, eta_star
+from damage_dolfinx.forms.contact import positive_part
 
 from damage_dolfinx.forms.elastic_damage import load
 

@@ -6,7 +6,7 @@ A = B / m_visc (viscosity, implicit), damaged truncated elasticity explicit (2.1
 """
 import ufl
 
-from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
+from damage_dolfinx.forms.constitutive import B, Phi_L, eps
 
 from damage_dolfinx.forms.elastic_damage import load
 

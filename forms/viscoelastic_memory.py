@@ -7,8 +7,8 @@ from g(eps, zeta) = zeta Phi_L(B eps) (memory.py).
 """
 import ufl
 
-from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
-from damage_dolfinx.numerics.contact import normal_compliance_term
+from damage_dolfinx.forms.constitutive import B, Phi_L, eps
+from damage_dolfinx.forms.contact import normal_compliance_term
 
 from damage_dolfinx.forms.elastic_damage import load
 

@@ -11,7 +11,7 @@ the cell values at the centroid (interpolation into DG0 = L2 projection; tested)
 """
 import ufl
 
-from damage_dolfinx.numerics.constitutive import B, Phi_L, eps
+from damage_dolfinx.forms.constitutive import B, Phi_L, eps
 
 from damage_dolfinx.forms.elastic_damage import load
 

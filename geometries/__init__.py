@@ -1,65 +1,8 @@
 """Geometries of the thesis examples. Each builder returns a :class:`Geometry` whose facet tags
 mark Gamma_D, Gamma_N and Gamma_C with the tags below."""
-from dataclasses import dataclass
-from typing import Optional
-
-GAMMA_D, GAMMA_N, GAMMA_C = 1, 2, 3
-
-
-@dataclass
-class StructuredGrid:
-    """The n_x x n_y grid (diagonals 'right') a structured mesh was cut from; meshes on grids
-    with nested spacing are nested, which the convergence studies use."""
-    x0: float
-    y0: float
-    Lx: float
-    Ly: float
-    nx: int
-    ny: int
-
-
-@dataclass
-class Geometry:
-    mesh: object
-    facet_tags: object
-    h: float                           # characteristic (maximal) cell diameter
-    grid: Optional[StructuredGrid] = None
-    description: str = ""
-    names: Optional[dict] = None       # gmsh physical names of the facet tags: {name: tag}
-
-
-_gmsh_ready = False
-
-
-class _LazyGmsh:
-    """The gmsh module, imported on first use: importing it costs about 0.3 s, which a run on
-    a built-in mesh never needs (the geometry modules are imported with the catalogue)."""
-
-    def __getattr__(self, name):
-        return getattr(_gmsh(), name)
-
-
-def _gmsh():
-    """The gmsh module, imported keeping the SIGINT handler (runtime.signals)."""
-    from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
-    import_gmsh_keeping_sigint()
-    import gmsh
-    return gmsh
-
-
-#: ``from damage_dolfinx.geometries import lazy_gmsh as gmsh`` in the gmsh-built geometries
-lazy_gmsh = _LazyGmsh()
-
-
-def gmsh_session():
-    """Initialise gmsh once per process (gmsh 4.8 has no isInitialized) and silence it."""
-    global _gmsh_ready
-    gmsh = _gmsh()
-    if not _gmsh_ready:
-        gmsh.initialize()
-        gmsh.option.setNumber("General.Terminal", 0)
-        _gmsh_ready = True
-    return gmsh
+from damage_dolfinx.compat.gmsh import gmsh_session, lazy_gmsh  # noqa: F401
+from damage_dolfinx.core.geometry import Geometry, StructuredGrid  # noqa: F401
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N  # noqa: F401
 
 
 def generate_2d(h):

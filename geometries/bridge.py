@@ -27,7 +27,7 @@ from damage_dolfinx.geometries import lazy_gmsh as gmsh
 import numpy as np
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 from damage_dolfinx.geometries import GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
 

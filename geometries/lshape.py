@@ -9,7 +9,7 @@ resting on the obstacle, gap 0), GAMMA_N = [0,2]x{2} (loaded top), FREE = the ot
 from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N, Geometry, generate_2d, gmsh_session
 

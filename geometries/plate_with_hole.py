@@ -40,7 +40,7 @@ def plate_with_hole_model(h: float, L: float = 2.0, H: float = 1.0, r: float = 0
 
 def plate_with_hole(comm, h: float, L: float = 2.0, H: float = 1.0, r: float = 0.25) -> Geometry:
     """The plate as a Geometry (meshed on rank 0, distributed), with its physical names."""
-    from damage_dolfinx.meshes import from_gmsh
+    from damage_dolfinx.problem.meshes import from_gmsh
     gmsh = gmsh_session()
     if comm.rank == 0:
         plate_with_hole_model(h, L, H, r)

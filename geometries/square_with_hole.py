@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 from damage_dolfinx.geometries import GAMMA_D, GAMMA_N, Geometry, StructuredGrid
 

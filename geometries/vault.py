@@ -24,7 +24,7 @@ from damage_dolfinx.geometries import lazy_gmsh as gmsh
 import numpy as np
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N, gmsh_session
 from damage_dolfinx.geometries.bridge import FREE, RING, SPAN, RISE, THICKNESS, ArchGeometry, _build_model, arch_dimensions

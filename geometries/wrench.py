@@ -22,7 +22,7 @@ import math
 from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_N, Geometry, gmsh_session
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from damage_dolfinx.geometries import lazy_gmsh as gmsh
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_N, Geometry, gmsh_session
 from damage_dolfinx.geometries.wrench import FREE, _build, _check, _classify, _mesh_sizes, _to_mesh

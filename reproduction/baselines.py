@@ -16,8 +16,8 @@ import ufl
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics.constitutive import eps as strain
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.forms.constitutive import eps as strain
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.numerics.solvers import ConvergenceError, set_default_options, spd_direct
 from damage_dolfinx.numerics.friction import law
 from damage_dolfinx.numerics.friction import register_solver

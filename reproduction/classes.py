@@ -165,7 +165,7 @@ def record_departures(summary: dict, catalogue=None) -> list:
     """The departure records of a run or study: its summary's ``reading`` record; for a
     summary written before runs recorded it, the catalogue's record of its example under the
     reading its assumptions name."""
-    from damage_dolfinx import departures
+    from damage_dolfinx.core import departures
     from damage_dolfinx.catalogue import examples
     reading = summary.get("reading")
     if isinstance(reading, dict):  # the short form from the recorded entry, as parsed today

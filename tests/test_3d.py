@@ -12,7 +12,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics import constitutive as C
+from damage_dolfinx.forms import constitutive as C
 
 HERE = Path(__file__).parent
 RNG = np.random.default_rng(17)
@@ -147,8 +147,8 @@ def uniaxial_block(k, s0, lam_plus, lam_minus, T=1.0, n=2, comm=MPI.COMM_WORLD):
     on x = 1, lam_D = 0: a homogeneous uniaxial strain eps = diag(e, 0, 0), e = s/(zeta M).
     Returns (times, zeta per step, e per step, largest deviation from homogeneity)."""
     from damage_dolfinx.geometries.box_with_hole import block
-    from damage_dolfinx.parameters import ModelParameters
-    from damage_dolfinx.problem import Problem
+    from damage_dolfinx.core.parameters import ModelParameters
+    from damage_dolfinx.problem.problem import Problem
     from damage_dolfinx.models.elastic_2_1 import ElasticDamage
     params = ModelParameters(E=E, nu=NU, kappa=1.0, zeta_star=0.01, q_star=1e3, variant="B",
                              lam_D=0.0, lam_u_plus=lam_plus, lam_u_minus=lam_minus,
@@ -257,7 +257,7 @@ def test_thin_plate_tends_to_plane_stress():
     order, and the difference must fall by a factor >= 1.5 at each halving."""
     from damage_dolfinx.catalogue import examples
     from damage_dolfinx.geometries.box_with_hole import box_with_hole
-    from damage_dolfinx.problem import Problem
+    from damage_dolfinx.problem.problem import Problem
     from damage_dolfinx.models.elastic_2_1 import ElasticDamage
     comm = MPI.COMM_SELF
     ex = examples.get("2.1-ex1")

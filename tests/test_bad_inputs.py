@@ -91,7 +91,7 @@ def test_every_argument_of_every_entry_point_has_a_rule():
     import inspect
     import numpy as np
     import damage_dolfinx as dd
-    from damage_dolfinx import validation
+    from damage_dolfinx.core import validation
     own = {"problem", "grid", "path", "dim", "model"}
     levels = {"n", "k"}  # converge: lists, by validation.levels
     for fn in (dd.run, dd.steps, dd.converge, dd.sweep, dd.read_mesh, dd.from_gmsh):

@@ -51,7 +51,7 @@ def test_default_geometry_matches_thesis_mesh():
 def test_unstructured_variant_and_options():
     from damage_dolfinx.geometries import GAMMA_D, GAMMA_N
     from damage_dolfinx.geometries.bridge import arch_bridge
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     comm = MPI.COMM_WORLD
     geo = arch_bridge(comm, h=0.15, structured=False, fill=True, abutments=True)
     tags = geo.facet_tags
@@ -70,7 +70,7 @@ def test_reactions_balance_self_weight_plus_load():
     from dolfinx import fem
     from damage_dolfinx import compat
     from damage_dolfinx.catalogue import examples
-    from damage_dolfinx.numerics.constitutive import eps
+    from damage_dolfinx.forms.constitutive import eps
     from damage_dolfinx.forms.elastic_damage import stress
     from damage_dolfinx.geometries import GAMMA_D
     stepper = examples.get("2.1-ex3").build(MPI.COMM_WORLD, h=0.2, k=0.001, T=0.01)
@@ -177,7 +177,7 @@ def test_literal_linear_step_leaves_the_admissible_set(tmp_path):
 
 
 def test_damage_bound_is_checked(tmp_path):
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     from damage_dolfinx.models.bridge_2_1 import check_bridge_parameters
     with pytest.raises(InputError, match="damage_bound"):
         check_bridge_parameters({"damage_bound": "projection"})

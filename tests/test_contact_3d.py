@@ -167,8 +167,8 @@ def test_dynamic_block_contact_force_balance(n):
     P = int v_z dx: it must hold at every step to the solver tolerance, as must the zero x- and
     y-momentum. n = 3: factorised velocity matrix; n = 10 (3993 unknowns): CG + GAMG."""
     from damage_dolfinx.geometries.box import box, face
-    from damage_dolfinx.parameters import ModelParameters
-    from damage_dolfinx.problem import Problem
+    from damage_dolfinx.core.parameters import ModelParameters
+    from damage_dolfinx.problem.problem import Problem
     from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
     p, rho, c_nu, k = 20.0, 1.0, 2e4, 0.01
     geometry = box(MPI.COMM_WORLD, (0.0, 0.0, 0.0), (1.0, 1.0, 1.0), (n, n, n),

@@ -12,11 +12,11 @@ from damage_dolfinx import compat
 from damage_dolfinx.catalogue import examples
 from damage_dolfinx.numerics import stability, stability_bound
 from damage_dolfinx.numerics.boundary import clamped
-from damage_dolfinx.numerics.constitutive import B_plane_stress, eps
+from damage_dolfinx.forms.constitutive import B_plane_stress, eps
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
-from damage_dolfinx.parameters import InputError
-from damage_dolfinx.problem import Problem
+from damage_dolfinx.core.parameters import InputError
+from damage_dolfinx.problem.problem import Problem
 from damage_dolfinx.models.dynamic_3_1 import DynamicKelvinVoigt
 
 COMM = MPI.COMM_WORLD

@@ -15,8 +15,8 @@ def _block_stepper(f, g, rho, k=0.02, T=0.1, L=2.0, H=1.0):
     (f, 0), no damage source."""
     from damage_dolfinx.geometries import GAMMA_C
     from damage_dolfinx.geometries.rectangle import rectangle, side
-    from damage_dolfinx.parameters import ModelParameters
-    from damage_dolfinx.problem import Problem
+    from damage_dolfinx.core.parameters import ModelParameters
+    from damage_dolfinx.problem.problem import Problem
     from damage_dolfinx.models.dynamic_tresca_3_2 import DynamicTresca
     geometry = rectangle(MPI.COMM_WORLD, (0, 0), (L, H), 8, 4, {GAMMA_C: side(1, 0.0)})
     params = ModelParameters(

@@ -9,8 +9,8 @@ from mpi4py import MPI
 from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
 from damage_dolfinx.geometries.rectangle import rectangle, side
-from damage_dolfinx.parameters import ModelParameters
-from damage_dolfinx.problem import Problem
+from damage_dolfinx.core.parameters import ModelParameters
+from damage_dolfinx.problem.problem import Problem
 from damage_dolfinx.models.memory_2_3 import ViscoelasticMemoryContact
 
 

@@ -101,7 +101,7 @@ def test_set_changing_within_the_step_goes_to_the_snes(unit_square):
 
 
 def test_bad_option_is_refused(unit_square):
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     PETSc.Options()["badopt_vi_fast_solver"] = "lu"
     msh = unit_square(4)
     Z = compat.scalar_p1(msh)

@@ -85,8 +85,8 @@ def test_a_run_records_its_assumptions_in_words():
     the assumed layouts from them)."""
     import json
 
-    from damage_dolfinx import departures
-    from damage_dolfinx.description import in_words
+    from damage_dolfinx.core import departures
+    from damage_dolfinx.problem.example import in_words
     label = re.compile(r"\bG\d+[a-z]?\b")
     assert in_words("1.9/G37: von Mises (G41: unit labels) (G3)") == \
         "assumed: von Mises (assumed: unit labels) (assumed)"

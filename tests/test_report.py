@@ -279,7 +279,7 @@ def test_quick_verdicts_and_table_departures():
 def test_runs_record_their_departures():
     """summary.json's reading record (written by every run) carries the departures from the
     stated text with their basis, including the stated values our data contradict."""
-    from damage_dolfinx import departures
+    from damage_dolfinx.core import departures
     from damage_dolfinx.catalogue import examples
     rec = departures.record(examples.get("2.3-ex1"))
     assert rec["name"] == "literal" and rec["departures"][0]["against_text"]

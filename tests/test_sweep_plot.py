@@ -14,7 +14,7 @@ from conftest import ENV
 from damage_dolfinx.catalogue.examples import catalogue
 from damage_dolfinx.geometries.rectangle import rectangle, side
 from damage_dolfinx.runtime.loop import Run
-from damage_dolfinx.validation_scalars import final_scalar_names
+from damage_dolfinx.problem.scalars import final_scalar_names
 
 #: one example of every model (n: a tiny structured mesh; None: the gmsh mesh as it is), with
 #: the data that select columns (2.2-ex3 and 3.3-ex2: a probe; 3.2-ex2: two named contact

@@ -120,7 +120,7 @@ def test_edge_between_contact_faces_is_refused():
     """Tresca on two faces meeting at an edge: the edge nodes have no coordinate-plane tangent
     plane; refused with one clear InputError before any solve."""
     from damage_dolfinx.numerics.friction import make_solver
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     with pytest.raises(InputError, match="coordinate plane"):
         make_solver("newton", _block(1.0, 1.0, contact="bottom and side"), eps_reg=1e-9,
                     rho_uzawa=0.1, omega_pd=10.0)

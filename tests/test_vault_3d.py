@@ -31,7 +31,7 @@ def test_vault_geometry_counts_and_tags():
     from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
     from damage_dolfinx.geometries.bridge import FREE, arch_bridge
     from damage_dolfinx.geometries.vault import END, barrel_vault
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     comm = MPI.COMM_WORLD
     geo = barrel_vault(comm, h=H, **COARSE)
     msh = geo.mesh
@@ -75,7 +75,7 @@ def test_line_load_and_self_weight_balance_the_reactions(monkeypatch):
     import ufl
     from dolfinx import fem
     from damage_dolfinx import compat
-    from damage_dolfinx.numerics.constitutive import eps
+    from damage_dolfinx.forms.constitutive import eps
     from damage_dolfinx.forms.elastic_damage import stress
     from damage_dolfinx.geometries import GAMMA_D
     stepper = vault_stepper(monkeypatch)

@@ -9,7 +9,7 @@ from mpi4py import MPI
 
 from conftest import load_run, rel_diff, run_cli, serial_and_two_ranks
 from damage_dolfinx import compat
-from damage_dolfinx.numerics.constitutive import B_plane_stress, eps
+from damage_dolfinx.forms.constitutive import B_plane_stress, eps
 from damage_dolfinx.forms.viscoplastic import viscoplastic_rate
 
 

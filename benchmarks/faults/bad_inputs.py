@@ -443,7 +443,7 @@ def run(p, out="o", **kw):
 API_HARNESS = '''
 import sys
 from mpi4py import MPI
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.numerics.solvers import ConvergenceError
 from damage_dolfinx.runtime.io import OutputError
 CODE = open(sys.argv[1]).read()

@@ -36,7 +36,7 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.catalogue import examples
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.forms.constitutive import eps
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from common import best, profile_rows, write_record  # noqa: E402

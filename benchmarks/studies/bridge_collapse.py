@@ -200,7 +200,7 @@ def report(result):
 
 
 def main():
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     args = parse()
     comm = MPI.COMM_WORLD
     out = Path(args.out)

@@ -27,7 +27,7 @@ import reproduction.baselines  # noqa: E402,F401 (registers uzawa and penalty-du
 from damage_dolfinx import compat  # noqa: E402
 from damage_dolfinx.catalogue import examples
 from damage_dolfinx.runtime import runner
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.forms.constitutive import eps
 from damage_dolfinx.numerics.solvers import ConvergenceError
 
 SOLVERS = ("newton", "uzawa", "penalty-duality")

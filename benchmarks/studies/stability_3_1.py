@@ -29,7 +29,7 @@ from damage_dolfinx.numerics import stability
 from damage_dolfinx.numerics.boundary import clamped
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.geometries.rectangle import rectangle, side
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 COMM = MPI.COMM_WORLD
 #: indicator threshold between smooth and chattering runs (measured: 0.010-0.012 below k_max,

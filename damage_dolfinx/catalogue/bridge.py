@@ -14,7 +14,7 @@ from __future__ import annotations
 
 
 from damage_dolfinx.catalogue.examples import Example, Figure, Reading
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 #: CALIBRATED (the only calibrated parameter): dP/dt of the quarter-span load [kN/s]. With the
@@ -54,7 +54,7 @@ EVIDENCE = Reading(
 
 def examples():
     from damage_dolfinx.geometries.bridge import RADIUS_CENTRE, THICKNESS, arch_bridge
-    from damage_dolfinx import model_defaults
+    from damage_dolfinx.models.registry import default_parameters as model_defaults
     BRIDGE_DEFAULTS = model_defaults("2.1-collapse").extra
 
     params = ModelParameters(

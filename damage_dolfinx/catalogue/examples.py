@@ -2,15 +2,15 @@
 
 Every value the thesis leaves open is an explicit assumption, listed in the example's
 ``assumptions`` and copied into each run's summary.json, its short label written out as
-"assumed" (:func:`damage_dolfinx.description.in_words`); docs/models.md gives the reasons,
-model by model. An example is a run description (:mod:`damage_dolfinx.description`) with the thesis's
+"assumed" (:func:`damage_dolfinx.problem.example.in_words`); docs/models.md gives the reasons,
+model by model. An example is a run description (:mod:`damage_dolfinx.problem.example`) with the thesis's
 metadata; this module only collects them by id.
 """
 from __future__ import annotations
 
-from damage_dolfinx.description import (MAX_STEPS, READINGS, Example, Figure,  # noqa: F401
+from damage_dolfinx.problem.example import (MAX_STEPS, READINGS, Example, Figure,  # noqa: F401
                                         Reading)
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 #: catalogue modules (damage_dolfinx/catalogue/<name>.py), each with examples() -> [Example]

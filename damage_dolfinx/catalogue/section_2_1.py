@@ -4,7 +4,7 @@ import math
 import ufl
 
 from damage_dolfinx.catalogue.examples import Example, Figure
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 def examples():

@@ -6,9 +6,9 @@ import ufl
 
 from damage_dolfinx.catalogue.examples import Example, Figure, Reading
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
-from damage_dolfinx.blocks import OMEGA_PD, RHO_UZAWA  # noqa: F401 (section_2_4, 3_2)
+from damage_dolfinx.models.blocks import OMEGA_PD, RHO_UZAWA  # noqa: F401 (section_2_4, 3_2)
 
 
 def _params(g_fric, solver="newton"):

@@ -4,7 +4,7 @@ import ufl
 
 from damage_dolfinx.catalogue.examples import Example, Figure
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 def examples():

@@ -10,7 +10,7 @@ from damage_dolfinx.catalogue.section_2_2 import OMEGA_PD, RHO_UZAWA
 
 
 def _params(g_fric, law="tresca"):
-    from damage_dolfinx import ModelParameters
+    from damage_dolfinx.core.parameters import ModelParameters
     return ModelParameters(  # the damage data of Section 2.2 (docs/models.md, section 2.4)
         E=1000.0, nu=0.3, kappa=1e-2, zeta_star=0.01, q_star=1000.0, variant="A", lam_D=0.1,
         lam_u=1000.0, lam_w=0.0, L_trunc=1000.0, stop_at_zeta_star=False,

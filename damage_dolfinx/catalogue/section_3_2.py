@@ -7,7 +7,7 @@ import ufl
 
 from damage_dolfinx.catalogue.examples import Example, Figure, Reading
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 from damage_dolfinx.catalogue.section_2_2 import OMEGA_PD, RHO_UZAWA
 
 

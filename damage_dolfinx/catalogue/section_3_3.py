@@ -8,7 +8,7 @@ import ufl
 
 from damage_dolfinx.catalogue.examples import Example, Figure
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 #: default time steps of Examples 2-3 (docs/models.md, section 3.3), 0.8 k_max or below and
 #: dividing T, from stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)

@@ -10,7 +10,7 @@ import ufl
 
 from damage_dolfinx.catalogue.examples import Example, Figure
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 #: 3-D contact examples (benchmarks/reference_output/contact_3d/): default mesh sizes and
 #: time steps; the k of the explicit dynamic schemes is at most 0.8 k_max of stability.py at the

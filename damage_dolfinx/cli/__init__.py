@@ -57,7 +57,7 @@ from mpi4py import MPI  # noqa: E402
 # (petsc_options.py), what each command does (commands.py); these names are their public face
 from damage_dolfinx.cli.commands import command  # noqa: E402
 from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser  # noqa: F401,E402
-from damage_dolfinx.cli.petsc_options import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401,E402
+from damage_dolfinx.problem.petsc_options import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401,E402
                                               _check_petsc_values, _forget, _petsc_options,
                                               _unused)
 
@@ -116,5 +116,5 @@ def _main(argv, comm, given):
 
 def _say(comm, text):
     if comm.rank == 0:
-        from damage_dolfinx.errors import for_command_line
+        from damage_dolfinx.core.errors import for_command_line
         print(for_command_line(text), file=sys.stderr, flush=True)

@@ -15,7 +15,7 @@ class _Parser(argparse.ArgumentParser):
         self.add_argument("--help", action="help", help="show this help and exit")
 
     def error(self, message):
-        from damage_dolfinx.parameters import InputError
+        from damage_dolfinx.core.parameters import InputError
         raise InputError(message)
 
 
@@ -129,7 +129,7 @@ def _sweep_parser(sub):
 
 
 def _overrides(pairs, friction_solver=None, friction_law=None, reading=None, args=None):
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     out = {} if friction_solver is None else {"friction_solver": friction_solver}
     if args is not None and args.allow_unstable:
         out["stability_check"] = "warn"
@@ -150,7 +150,7 @@ def _overrides(pairs, friction_solver=None, friction_law=None, reading=None, arg
 def _check_finite(args):
     """Every number on the command line is finite (argparse's float() accepts 'inf' and 'nan')."""
     import math
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     for name, value in vars(args).items():
         for v in value if isinstance(value, list) else [value]:
             if isinstance(v, float) and not math.isfinite(v):

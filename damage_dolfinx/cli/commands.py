@@ -9,7 +9,7 @@ import sys
 from mpi4py import MPI
 
 from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser
-from damage_dolfinx.cli.petsc_options import _check_petsc_values, _petsc_options, _unused
+from damage_dolfinx.problem.petsc_options import _check_petsc_values, _petsc_options, _unused
 
 
 def command(argv, comm, given):
@@ -64,7 +64,7 @@ def command(argv, comm, given):
 
 
 def _sweep(args):
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     from damage_dolfinx.studies.sweep import parse_values, sweep
     if not args.set:
         raise InputError("sweep needs at least one --set NAME=V1,V2,...")
@@ -98,7 +98,7 @@ def _load_plugins():
     """Import the modules named in DAMAGE_DOLFINX_PLUGINS (comma-separated): they may register
     models (damage_dolfinx.register_model), friction solvers or case sources before the run."""
     import importlib
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     for name in filter(None, (n.strip() for n in os.environ.get("DAMAGE_DOLFINX_PLUGINS",
                                                                   "").split(","))):
         try:

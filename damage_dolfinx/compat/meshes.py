@@ -140,7 +140,7 @@ def read_msh(comm, path, rank=0, gdim=None, check=None):
     the geometric dimension (None: the model's dimension). ``check(gmsh) -> str | None`` looks at
     the model on ``rank`` before anything is distributed; a message (or gmsh's own error while
     reading) raises ValueError on every rank."""
-    from damage_dolfinx.geometries import gmsh_session
+    from damage_dolfinx.compat.gmsh import gmsh_session
     gmsh = gmsh_session()
     dim, error = None, None
     if comm.rank == rank:

@@ -38,9 +38,9 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from damage_dolfinx import compat
-from damage_dolfinx.runtime import bookkeeping
-from damage_dolfinx.numerics.constitutive import eps
-from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
+from damage_dolfinx.numerics import bookkeeping
+from damage_dolfinx.forms.constitutive import eps
+from damage_dolfinx.core.parameters import InputError, ModelParameters, TimeGrid
 from damage_dolfinx.numerics.solvers import SolveContext
 
 #: the damage data of the obstacle-inclusion models' defaults (variant A, (1.3))
@@ -124,7 +124,7 @@ class Model:
     def boundary_roles(cls) -> dict:
         """role -> the facet tag the model reads there: ``clamped`` 1 (Gamma_D), ``traction`` 2
         (Gamma_N), each of ``contact_roles`` 3 (Gamma_C), and ``extra_roles``."""
-        from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+        from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
         return {"clamped": GAMMA_D, "traction": GAMMA_N,
                 **{role: GAMMA_C for role in cls.contact_roles}, **cls.extra_roles}
 
@@ -294,7 +294,7 @@ class Model:
     def damage_source(self, e, z):
         """The damage source phi(e, z) of this run: the user's law, or the thesis law (1.3) or
         (1.4) of ``params.variant``."""
-        from damage_dolfinx.laws import thesis_law
+        from damage_dolfinx.models.laws import thesis_law
         law = self.data.damage_law or thesis_law(self.params.variant)
         return law(e, z, self.params)
 
@@ -373,7 +373,7 @@ class Model:
             if p is None:
                 self._resultant_forms = None
             else:
-                from damage_dolfinx.geometries import GAMMA_C
+                from damage_dolfinx.core.tags import GAMMA_C
                 n = ufl.FacetNormal(self.mesh)
                 degree = self.contact_quadrature_degree
                 ds = ufl.Measure("ds", domain=self.mesh,

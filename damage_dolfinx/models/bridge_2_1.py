@@ -58,11 +58,10 @@ import ufl
 from dolfinx import fem
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.forms.constitutive import eps
 from damage_dolfinx.numerics.damage import DamageStep
-from damage_dolfinx.geometries import GAMMA_N
-from damage_dolfinx.parameters import InputError, ModelParameters
-from damage_dolfinx.problem import Problem
+from damage_dolfinx.core.tags import GAMMA_N
+from damage_dolfinx.core.parameters import InputError, ModelParameters
 from damage_dolfinx.models.bridge_sections import RingSections
 from damage_dolfinx.models.elastic_2_1 import ElasticDamage
 
@@ -145,7 +144,7 @@ class BridgeDamage(RingSections, ElasticDamage):
         check_bridge_parameters(params.extra)
         return params
 
-    def __init__(self, data: Problem, **kwargs):
+    def __init__(self, data, **kwargs):
         geo = data.geometry
         if not hasattr(geo, "section_index"):
             raise InputError("example 2.1-ex3 needs the arch geometry (geometries/bridge.py); "

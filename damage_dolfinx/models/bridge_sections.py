@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 def _allreduce(comm, array: np.ndarray, op) -> np.ndarray:

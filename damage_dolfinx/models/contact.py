@@ -29,5 +29,5 @@ class NormalComplianceScalars:
 
     def contact_pressure(self):
         """p_nu(u_n.nu - gap) = c_nu (u_n.nu - gap)_+ on Gamma_C."""
-        from damage_dolfinx.numerics.contact import normal_compliance_pressure
+        from damage_dolfinx.forms.contact import normal_compliance_pressure
         return normal_compliance_pressure(self.u, self.n_facet, self.c_nu, self.gap)

@@ -36,19 +36,18 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
-from damage_dolfinx.runtime import bookkeeping
+from damage_dolfinx.numerics import bookkeeping
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_kelvin_voigt import inertia_form, total_stress, velocity_step_forms
 from damage_dolfinx.numerics.solvers import DIRECT, LinearSolver, serial_block_lu
-from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
-from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 #: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
@@ -78,7 +77,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
                                       "damage_active": True, "stability_check": "error",
                                       "error_norm": "velocity"})
 
-    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

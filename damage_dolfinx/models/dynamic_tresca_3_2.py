@@ -23,19 +23,18 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.constitutive import eps, von_mises
 from damage_dolfinx.forms.dynamic_tresca import total_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import checked, estimate_stability
-from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
-from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 class DynamicTresca(Model):
@@ -62,7 +61,7 @@ class DynamicTresca(Model):
                                extra={"rho": 1.0, "m_visc": 100.0, "g_fric": 5.0,
                                       "stability_check": "error", **FRICTION_DEFAULTS})
 
-    def __init__(self, data: Problem):
+    def __init__(self, data):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

@@ -26,15 +26,14 @@ from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.forms.elastic_damage import equilibrium_forms, stress
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.forms.constitutive import eps, von_mises
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.numerics.solvers import LinearSolver, lagged_direct
 
 #: CG iterations above which the lagged elasticity factorisation is rebuilt
 MECH_REFACTOR_ITS = 8
-from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import Model, SubStep
-from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 class ElasticDamage(Model):
@@ -53,7 +52,7 @@ class ElasticDamage(Model):
                                variant="B", lam_D=0.1, lam_w=0.0, lam_u_plus=1000.0,
                                lam_u_minus=100.0, stop_at_zeta_star=True)
 
-    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh = self.params, self.mesh
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

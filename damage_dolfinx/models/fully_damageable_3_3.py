@@ -44,20 +44,19 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
-from damage_dolfinx.runtime import bookkeeping
+from damage_dolfinx.numerics import bookkeeping
 from damage_dolfinx.numerics.boundary import clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.constitutive import eps, von_mises
 from damage_dolfinx.forms.fully_damageable import (implicit_velocity_residual, total_stress,
                                       velocity_matrix_parts, velocity_rhs_boundary,
                                       velocity_step_forms)
-from damage_dolfinx.parameters import InputError, ModelParameters
+from damage_dolfinx.core.parameters import InputError, ModelParameters
 from damage_dolfinx.numerics.solvers import LinearSolver, NonlinearSolver
 from damage_dolfinx.models.monitors import ContactMonitor, DamageProfiles, ZetaProbe  # noqa: F401 (also imported from here)
 from damage_dolfinx.numerics.zeta_linear import VelocitySolver
-from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 
 #: velocity system (3.159): SPD, mass-dominated for small k -> CG + Jacobi, nonzero start (see
@@ -104,7 +103,7 @@ class FullyDamageableContact(Model):
         return (["v_L2", "penetration_max"] + [f"penetration_x{i + 1}" for i in range(dim)]
                 + ([] if problem.builders.get("probe") is None else ["zeta_probe"]))
 
-    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

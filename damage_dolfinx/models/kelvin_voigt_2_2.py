@@ -22,18 +22,17 @@ from dolfinx import fem
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.constitutive import eps, von_mises
 from damage_dolfinx.numerics.contact_output import near_contact
 from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
-from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
-from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 
 class KelvinVoigtTresca(Model):
@@ -59,7 +58,7 @@ class KelvinVoigtTresca(Model):
         stable iff k m_visc zeta <= 2, so k_max = 2/m_visc (zeta <= 1)."""
         return 2.0 / float(params.extra["m_visc"])
 
-    def __init__(self, data: Problem):
+    def __init__(self, data):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

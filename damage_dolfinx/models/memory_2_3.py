@@ -25,23 +25,22 @@ import numpy as np
 import ufl
 from dolfinx import fem
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics import scalable
 from damage_dolfinx.numerics.boundary import clamped
-from damage_dolfinx.numerics.constitutive import B_coefficients, eps, von_mises
+from damage_dolfinx.forms.constitutive import B_coefficients, eps, von_mises
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_stress, total_stress
 from damage_dolfinx.numerics.memory import CellwiseIntegrand, MemoryKernel, MemoryTerm
 from damage_dolfinx.numerics.split_residual import SplitResidual, affine_cell_split
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.numerics.solvers import NEWTON, NonlinearSolver, lagged_direct
-from damage_dolfinx.problem import Problem
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.models.contact import NormalComplianceScalars
-from damage_dolfinx.parameters import ModelParameters
-from damage_dolfinx.runtime import bookkeeping
+from damage_dolfinx.core.parameters import ModelParameters
+from damage_dolfinx.numerics import bookkeeping
 
 
 #: Krylov iterations above which the lagged Jacobian factorisation is rebuilt (with a Krylov
@@ -85,7 +84,7 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
                                       "memory_amplitude": 1.0, "memory_rate": 1.0,
                                       "memory_mode": "auto"})
 
-    def __init__(self, data: Problem, mech_prefix="mech_", damage_prefix="damage_"):
+    def __init__(self, data, mech_prefix="mech_", damage_prefix="damage_"):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z = compat.vector_p1(msh), compat.scalar_p1(msh)

@@ -10,7 +10,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 class ContactMonitor:

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import importlib
 
-from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION  # noqa: F401
-from damage_dolfinx.parameters import InputError, ModelParameters
+from damage_dolfinx.core.parameters import InputError, ModelParameters
+from damage_dolfinx.core.tags import CONTACT_ROLES  # what Gamma_C may mean
+from damage_dolfinx.core.tags import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION  # noqa: F401
 
-from damage_dolfinx.meshes import CONTACT_ROLES  # noqa: E402 (what Gamma_C may mean)
 ROLES = ("clamped", "traction") + CONTACT_ROLES
 
 #: the modules under damage_dolfinx/models/ holding the catalogue's models, in catalogue order

@@ -21,18 +21,17 @@ import ufl
 from dolfinx import fem
 from mpi4py import MPI
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces, clamped
-from damage_dolfinx.numerics.constitutive import eps, von_mises
+from damage_dolfinx.forms.constitutive import eps, von_mises
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
-from damage_dolfinx.problem import Problem
-from damage_dolfinx.runtime import bookkeeping
+from damage_dolfinx.numerics import bookkeeping
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
 from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
-from damage_dolfinx.parameters import ModelParameters
+from damage_dolfinx.core.parameters import ModelParameters
 
 FRICTION_LAWS = ("tresca", "coulomb")
 
@@ -72,7 +71,7 @@ class ElastoViscoplasticFriction(Model):
             return params.replace(friction_law="coulomb" if "coulomb" in roles else "tresca")
         return params
 
-    def __init__(self, data: Problem):
+    def __init__(self, data):
         super().__init__(data)
         p, msh, x = self.params, self.mesh, data.params.extra
         V, Z, Q = compat.vector_p1(msh), compat.scalar_p1(msh), compat.tensor_dg0(msh)

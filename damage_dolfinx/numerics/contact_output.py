@@ -38,9 +38,9 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D
-from damage_dolfinx.runtime import bookkeeping
-from damage_dolfinx.numerics.contact import (NODAL_QUADRATURE, NODAL_QUADRATURE_3D,  # noqa: F401
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D
+from damage_dolfinx.numerics import bookkeeping
+from damage_dolfinx.forms.contact import (NODAL_QUADRATURE, NODAL_QUADRATURE_3D,  # noqa: F401
                                              normal_compliance_pressure)
 
 

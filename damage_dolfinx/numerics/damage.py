@@ -14,7 +14,7 @@ from dolfinx import fem
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics.constitutive import Psi_q, eta_star, split_norms_sq
+from damage_dolfinx.forms.constitutive import Psi_q, eta_star, split_norms_sq
 from damage_dolfinx.forms.damage import damage_step_forms
 from damage_dolfinx.numerics.obstacle import CHOLESKY_MAX_DOFS, ObstacleFastPath, fast_path_options
 from damage_dolfinx.numerics.solvers import (DIRECT, ConvergenceError, LinearSolver, SNESSolver, SolveContext,

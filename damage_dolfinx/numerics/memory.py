@@ -24,7 +24,7 @@ import numpy as np
 from dolfinx import fem
 
 from damage_dolfinx import compat
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 @dataclass(frozen=True)

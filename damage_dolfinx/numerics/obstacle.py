@@ -47,7 +47,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 #: PETSc's vinewtonrsls counts a value within this distance of a bound as on it
 VI_BOUND_WINDOW = 1e-8

@@ -109,7 +109,7 @@ def _whole_option(prefix: str, option: str, default: int, what: str) -> int:
     except ValueError:
         value = float("nan")
     if not (value >= 0 and value == int(value)):
-        from damage_dolfinx.parameters import InputError
+        from damage_dolfinx.core.parameters import InputError
         raise InputError(f"-{name} must be a whole number of {what} >= 0, got {raw!r}")
     return int(value)
 

@@ -19,8 +19,7 @@ from damage_dolfinx import compat
 from damage_dolfinx.numerics.callbacks import form_callbacks, relative_change
 
 
-class ConvergenceError(RuntimeError):
-    """A PETSc solver did not converge; the message names example, step, time and residual."""
+from damage_dolfinx.core.errors import ConvergenceError  # noqa: F401
 
 
 @dataclass

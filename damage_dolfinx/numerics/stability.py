@@ -45,8 +45,8 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics import stability_bound, stability_cache
-from damage_dolfinx.numerics.constitutive import B, eps
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.forms.constitutive import B, eps
+from damage_dolfinx.core.parameters import InputError
 
 #: safety factor of the suggested time step (0.8 k_max)
 SAFETY = 0.8

@@ -18,8 +18,7 @@ import numpy as np
 from mpi4py import MPI
 
 
-class OutputError(Exception):
-    """An output file could not be written (disk full, I/O error, folder deleted); one line."""
+from damage_dolfinx.core.errors import OutputError  # noqa: F401
 
 
 def describe(exc: BaseException, folder=None) -> str:

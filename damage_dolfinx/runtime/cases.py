@@ -5,7 +5,7 @@ knows (the thesis catalogue registers its ids when ``damage_dolfinx.catalogue`` 
 the run machinery does not import it)."""
 from __future__ import annotations
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 _SOURCES: list = []
 

@@ -27,7 +27,7 @@ from mpi4py import MPI
 
 from damage_dolfinx import compat
 from damage_dolfinx.runtime import io
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 FORMAT = "damage-dolfinx/checkpoint/v1"
 #: statuses of a run that has nothing left to do (a larger T continues a "completed" one)

@@ -47,7 +47,7 @@ class RankFailure(Exception):
 
 def classify(exc) -> tuple:
     """(exit status, prefix, status word) of an exception, the command line's convention."""
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     from damage_dolfinx.runtime.atomic import OutputError
     from damage_dolfinx.runtime.signals import RunInterrupted
     if isinstance(exc, RankFailure):
@@ -78,7 +78,7 @@ _STATUS = {"error": "refused", "output error": "failed", "": "interrupted",
 
 def describe(exc) -> str:
     """The exception as one line (user code: its type and message)."""
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     from damage_dolfinx.runtime.atomic import OutputError
     from damage_dolfinx.runtime.signals import RunInterrupted
     from damage_dolfinx.numerics.solvers import ConvergenceError
@@ -129,7 +129,7 @@ def created(folder):
 
 def _tidy(exc, rank):
     """A refused call leaves no empty folder it created."""
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     folders, _CREATED[:] = list(_CREATED), []
     if rank != 0 or not isinstance(exc, InputError):
         return
@@ -283,7 +283,7 @@ def outcome(comm=MPI.COMM_WORLD):
 def decided(text, code, kind) -> RankFailure:
     """The decided failure on a rank that did not raise it: a RankFailure that is also of the
     package's exception of its kind (``except dd.InputError`` catches it on every rank)."""
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     from damage_dolfinx.runtime.atomic import OutputError
     from damage_dolfinx.numerics.solvers import ConvergenceError
     base = {"error": InputError, "output error": OutputError,
@@ -300,7 +300,7 @@ _DECIDED: dict = {}
 
 
 def InputError_():
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     return InputError("")
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
+from damage_dolfinx.core.tags import GAMMA_C, GAMMA_D, GAMMA_N
 from damage_dolfinx.viz import post
 
 

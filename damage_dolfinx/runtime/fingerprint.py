@@ -30,7 +30,7 @@ import json
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.runtime import io
 
 #: the fingerprint's format: the loads' and laws' hashes (and a zeta0 function's digest) of
@@ -58,7 +58,7 @@ def fingerprint(ex, data) -> dict:
     literals and constants' values included: a traction 100 times larger changes it), the
     initial damage, the boundary parts, irreversibility, the reading, the model's own data
     (builders) and the PETSc options given. Collective on the mesh's ranks."""
-    from damage_dolfinx.meshes import tag_counts
+    from damage_dolfinx.problem.meshes import tag_counts
     msh = data.geometry.mesh
     comm = msh.comm
     tdim, gdim = msh.topology.dim, msh.geometry.dim
@@ -211,7 +211,7 @@ def given_options() -> list:
     if "petsc4py.PETSc" not in sys.modules:
         return []
     from petsc4py import PETSc
-    from damage_dolfinx.cli.petsc_options import PETSC_PREFIXES
+    from damage_dolfinx.problem.petsc_options import PETSC_PREFIXES
     from damage_dolfinx.numerics import solvers
     given = []
     for name, value in PETSc.Options().getAll().items():
@@ -320,7 +320,7 @@ def _values_of(expr) -> str:
 
 
 def _thesis_law(params):
-    from damage_dolfinx.laws import thesis_law
+    from damage_dolfinx.models.laws import thesis_law
     return thesis_law(params.variant)
 
 

@@ -8,7 +8,7 @@ import time
 import numpy as np
 
 from damage_dolfinx.numerics.solvers import ConvergenceError
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 class Progress:

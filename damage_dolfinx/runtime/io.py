@@ -29,7 +29,7 @@ from damage_dolfinx import compat
 from damage_dolfinx.runtime import series
 from damage_dolfinx.runtime.atomic import (STUCK_SECONDS, OutputError, atomic_write_bytes, collective,  # noqa: F401
                      describe, npz_writer, strict_json, write_json)
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 def prepare_output_dir(path, comm=MPI.COMM_WORLD) -> Path:
@@ -62,7 +62,7 @@ def environment(comm=MPI.COMM_WORLD) -> dict:
     import petsc4py
     import ufl
     from petsc4py import PETSc
-    from damage_dolfinx import __version__
+    from damage_dolfinx.core.version import __version__
     return {"damage_dolfinx": __version__, "dolfinx": compat.DOLFINX_VERSION,
             "ufl": ufl.__version__, "petsc": ".".join(map(str, PETSc.Sys.getVersion())),
             "petsc4py": petsc4py.__version__, "python": platform.python_version(),

@@ -11,17 +11,17 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from damage_dolfinx import departures
+from damage_dolfinx.core import departures
 from damage_dolfinx.numerics.contact_output import ContactOutput
 from damage_dolfinx.numerics.solvers import ConvergenceError
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.runtime.cases import resolve
 from damage_dolfinx.runtime.guards import Progress, solver_step
 from damage_dolfinx.runtime.records import RunRecords
 from damage_dolfinx.runtime.runfolder import (RunLock, check_mesh_file, claim_folder,
                                               previous_run)
-from damage_dolfinx.runtime.runner import CHECKPOINT_SECONDS, Step
+from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS, Step
 from damage_dolfinx.runtime.signals import StopSignals
 from damage_dolfinx.runtime.steps import together
 

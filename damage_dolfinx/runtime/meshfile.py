@@ -7,7 +7,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 def check_mesh_file(path, dim, required_tags=(), comm=MPI.COMM_WORLD):
@@ -23,7 +23,7 @@ def check_mesh_file(path, dim, required_tags=(), comm=MPI.COMM_WORLD):
 
 
 def _mesh_problem(path, dim, required):
-    from damage_dolfinx.validation import cell_types_problem, mesh_path_problem
+    from damage_dolfinx.core.validation import cell_types_problem, mesh_path_problem
     problem = mesh_path_problem(path)
     if problem:
         return problem
@@ -67,7 +67,7 @@ def _gmsh():
     """The gmsh module, initialised (gmsh 4.8 has no isInitialized; DOLFINx's reader finalises
     gmsh after reading a file, behind geometries.gmsh_session's back)."""
     import os
-    from damage_dolfinx.geometries import gmsh_session
+    from damage_dolfinx.compat.gmsh import gmsh_session
     gmsh = gmsh_session()
     saved = os.dup(2)  # gmsh prints "not initialized" itself before raising
     try:

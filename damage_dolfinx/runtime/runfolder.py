@@ -18,7 +18,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from damage_dolfinx.runtime import checkpoint
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 #: files of a run written before manifests existed (what --overwrite removes there, with the
 #: outputs its summary.json names)

@@ -33,9 +33,7 @@ from damage_dolfinx.runtime.guards import (PDE_STATE_MARGIN, STATE_TOLERANCE,  #
                                            Progress, solver_step)
 from damage_dolfinx.runtime.records import ColumnError  # noqa: F401
 from damage_dolfinx.runtime.signals import STOP_SIGNALS, RunInterrupted  # noqa: F401
-
-#: default wall-time interval between checkpoints (seconds)
-CHECKPOINT_SECONDS = 120.0
+from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS, Step  # noqa: F401
 
 
 def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
@@ -71,7 +69,7 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     into (runfolder.claim_folder: the manifest). A NaN, an infinity or a zeta outside
     [zeta_star, 1] (beyond STATE_TOLERANCE) in a field, and every exception of a solver, end
     the run as a ConvergenceError with status "failed" in summary.json."""
-    from damage_dolfinx.runtime.loop import Run
+    from damage_dolfinx.runtime.loop import Run  # imported when a run starts (dolfinx)
     r = Run.prepare(example_id, out, n, k, T, h, overrides, mesh_file, write_every, progress,
                     figures, time_limit, checkpoint_every, checkpoint_seconds, restart,
                     overwrite, history_every, comm)
@@ -84,26 +82,3 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         r.abandon(steps)
         raise
     return r.summary
-
-
-class Step:
-    """What a run hands over after each step: ``n``, ``t``, the ``model`` and its live
-    Functions ``u``, ``zeta``, ``v`` (None where the scheme has none), the run's ``summary``
-    (so far), ``contact_pressure`` (the model's UFL pressure on Gamma_C, None without normal
-    contact) and :meth:`contact_resultant`."""
-
-    def __init__(self, run):
-        self._run = run
-
-    model = property(lambda self: self._run.stepper)
-    n = property(lambda self: self._run.stepper.n)
-    t = property(lambda self: self._run.stepper.t)
-    u = property(lambda self: self._run.stepper.u)
-    zeta = property(lambda self: self._run.stepper.zeta)
-    v = property(lambda self: getattr(self._run.stepper, "v", None))
-    summary = property(lambda self: self._run.summary)
-    contact_pressure = property(lambda self: self._run.stepper.contact_pressure())
-
-    def contact_resultant(self):
-        """int_{Gamma_C} p nu ds (a vector, every rank; None without normal contact)."""
-        return self._run.stepper.contact_resultant()

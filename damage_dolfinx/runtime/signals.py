@@ -13,12 +13,7 @@ import time
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1)
 
 
-class RunInterrupted(Exception):
-    """The run stopped on a signal after writing a checkpoint; exit status 128 + signal."""
-
-    def __init__(self, signum: int, message: str):
-        super().__init__(message)
-        self.signum, self.exit_status = signum, 128 + signum
+from damage_dolfinx.core.errors import RunInterrupted  # noqa: F401
 
 
 #: the first stop signal this process received (0: none); a failure while one is pending is an
@@ -55,22 +50,7 @@ def keeping_sigint():
             signal.signal(signal.SIGINT, handler)
 
 
-def import_gmsh_keeping_sigint():
-    """gmsh's Python module sets SIGINT to its default action (killing the process, with no
-    line and no status) when it is first imported: import it now, if it is there, and put the
-    handler back. Every import of gmsh in the package goes through here, where gmsh is first
-    needed (it costs about 0.3 s, which a run on a built-in mesh does not pay)."""
-    import sys
-    if "gmsh" in sys.modules or threading.current_thread() is not threading.main_thread():
-        return
-    handler = signal.getsignal(signal.SIGINT)
-    try:
-        import gmsh  # noqa: F401
-    except Exception:  # noqa: BLE001 - no gmsh: nothing to protect against
-        pass
-    finally:
-        if handler is not None:
-            signal.signal(signal.SIGINT, handler)
+from damage_dolfinx.compat.gmsh import import_gmsh_keeping_sigint  # noqa: E402,F401
 
 
 class StopSignals:

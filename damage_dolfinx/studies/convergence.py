@@ -26,7 +26,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx.runtime import io
-from damage_dolfinx.parameters import InputError, TimeGrid
+from damage_dolfinx.core.parameters import InputError, TimeGrid
 from damage_dolfinx.runtime.runner import Progress, solver_step
 from damage_dolfinx.studies.convergence_tables import (fitted_rates, plot_convergence,  # noqa: F401
                                                       write_tables)

@@ -20,7 +20,7 @@ from dolfinx import fem
 from mpi4py import MPI
 
 from damage_dolfinx.numerics.solvers import ConvergenceError
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.runtime.runner import solver_step
 from damage_dolfinx.studies.point_transfer import (COMPARISON, NESTED_COMPARISON, OUTSIDE_TOLERANCE,
                                                    PointValues, ReferencePoints)

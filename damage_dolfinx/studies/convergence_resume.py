@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.runtime.fingerprint import ITEMS, first_difference, fingerprint
 
 SCHEMA = "damage-dolfinx/convergence/v1"

@@ -55,7 +55,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.studies.sweep_folder import (SCHEMA, STATUS_COLUMNS,  # noqa: F401
                                                  SWEEP_FILES, plot_sweep)
 from damage_dolfinx.studies.sweep_folder import describe_values as _describe
@@ -135,7 +135,7 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
     this point (0-based, the row of ``sweep.csv``), on all ranks, for a job of a job array;
     several processes may run points of the same ``out`` at once."""
     from damage_dolfinx.runtime.collective import outcome
-    from damage_dolfinx.validation import check_sweep, communicator
+    from damage_dolfinx.core.validation import check_sweep, communicator
     with outcome(communicator("comm", comm)):
         checked = check_sweep(grid, n, k, T, restart, max_points, plot, figures, progress,
                               out, comm)
@@ -145,7 +145,7 @@ def sweep(problem, out, grid, *, n=None, k=None, T=None, restart=False, max_poin
 
 def _check_layout(ranks_per_point, point, max_points, comm) -> dict:
     """ranks_per_point and point, refused (InputError) before any work when they cannot be."""
-    from damage_dolfinx.validation import whole
+    from damage_dolfinx.core.validation import whole
     size = comm.size
     ranks = whole("ranks_per_point", ranks_per_point, allow_none=True)
     point = whole("point", point, low=0, allow_none=True)
@@ -178,7 +178,7 @@ def _check_point(ex, i, values, n, k, T, meshes, together, comm, plot=None):
     except InputError as exc:
         raise _point_error(ex, i, values, n, k, T, exc, c is not None, comm) from None
     if plot is not None:  # the first point checked: the scalars its run reports
-        from damage_dolfinx.validation_scalars import check_plot
+        from damage_dolfinx.problem.scalars import check_plot
         check_plot(plot, c, geometry, comm)
     return size
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 #: points.json schema
 SCHEMA = "damage-dolfinx/sweep/v1"

@@ -8,7 +8,7 @@ import ufl
 from mpi4py import MPI
 
 from damage_dolfinx import compat
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.forms.constitutive import eps
 
 
 # ---------------------------------------------------------------------------- nested transfer
@@ -228,7 +228,7 @@ def plot_mesh(geometry, path, title="", labels=None, loads=None, split=None):
     from :func:`setting_loads`: traction on the Gamma_N facets, body force inside), the legend
     below the axes; collective."""
     from damage_dolfinx.viz import figstyle
-    from damage_dolfinx.geometries import GAMMA_N
+    from damage_dolfinx.core.tags import GAMMA_N
     msh, tags = geometry.mesh, geometry.facet_tags
     xy = msh.comm.gather(compat.cell_vertex_coords(msh), root=0)
     parts = {}

@@ -15,8 +15,8 @@ from dolfinx import fem
 from common import Outputs, Setting, newton, obstacle_damage, tresca_regularised
 from damage_dolfinx.forms.dynamic_tresca import velocity_step_forms
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx.laws import thesis_law
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.models.laws import thesis_law
+from damage_dolfinx.forms.constitutive import eps
 
 s = Setting("3.2-ex1", 64, 0.002, "plain_3_2")
 p, x_ = s.p, s.x_

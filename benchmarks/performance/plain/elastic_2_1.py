@@ -17,8 +17,8 @@ from common import Outputs, Setting, assemble_rhs, lu
 from damage_dolfinx.forms.damage import damage_step_forms
 from damage_dolfinx.forms.elastic_damage import equilibrium_forms
 from damage_dolfinx.geometries import GAMMA_D, GAMMA_N
-from damage_dolfinx.laws import thesis_law
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.models.laws import thesis_law
+from damage_dolfinx.forms.constitutive import eps
 
 s = Setting("2.1-ex1", 160, 0.01, "plain_2_1")
 p = s.p

@@ -15,8 +15,8 @@ from dolfinx.fem import petsc as fpetsc
 from common import Outputs, Setting, assemble_rhs, lu, obstacle_damage
 from damage_dolfinx.forms.fully_damageable import velocity_step_forms
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx.laws import thesis_law
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.models.laws import thesis_law
+from damage_dolfinx.forms.constitutive import eps
 
 s = Setting("3.3-ex1", 64, 0.002, "plain_3_3")
 p, x_ = s.p, s.x_

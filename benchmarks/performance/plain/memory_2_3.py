@@ -18,8 +18,8 @@ from common import Outputs, Setting, assemble_rhs, lu, newton
 from damage_dolfinx.forms.damage import damage_step_forms
 from damage_dolfinx.forms.viscoelastic_memory import displacement_residual, memory_integrand
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx.laws import thesis_law
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.models.laws import thesis_law
+from damage_dolfinx.forms.constitutive import eps
 
 s = Setting("2.3-ex1", 64, 0.002, "plain_2_3")
 p, x_ = s.p, s.x_

@@ -16,8 +16,8 @@ from dolfinx import fem
 from common import Outputs, Setting, newton, obstacle_damage, tresca_regularised
 from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_update, viscoplastic_rate
 from damage_dolfinx.geometries import GAMMA_C, GAMMA_D, GAMMA_N
-from damage_dolfinx.laws import thesis_law
-from damage_dolfinx.numerics.constitutive import eps
+from damage_dolfinx.models.laws import thesis_law
+from damage_dolfinx.forms.constitutive import eps
 
 s = Setting("2.4-ex1", 64, 0.002, "plain_2_4")
 p, x_ = s.p, s.x_

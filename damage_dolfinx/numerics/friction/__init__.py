@@ -46,7 +46,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.numerics.friction import law
 from damage_dolfinx.numerics.friction.active_set import PrimalDualActiveSet
 from damage_dolfinx.numerics.friction.newton import (FAST_MAX_IT, FAST_PAUSE_STEPS, FRICTION_NEWTON, PDAS_MAX_IT, REFACTOR_ITS,

@@ -13,7 +13,7 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.condensed import BlockUpdateSolver, DiagonalUpdatePC
-from damage_dolfinx.numerics.contact import F_reg, F_reg_vector, Phi_reg, Phi_reg_vector
+from damage_dolfinx.forms.contact import F_reg, F_reg_vector, Phi_reg, Phi_reg_vector
 from damage_dolfinx.numerics.solvers import (NEWTON, ConvergenceError, NonlinearSolver, replace_default_option,
                        spd_direct)
 from damage_dolfinx.numerics.friction.active_set import PrimalDualActiveSet

@@ -17,8 +17,8 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics import scalable
-from damage_dolfinx.numerics.contact import NODAL_QUADRATURE, NODAL_QUADRATURE_3D, tangent, tangential_part
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.forms.contact import NODAL_QUADRATURE, NODAL_QUADRATURE_3D, tangent, tangential_part
+from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.numerics.condensed import lu_direct
 from damage_dolfinx.numerics.solvers import SolveContext, spd_direct
 

@@ -1,6 +1,6 @@
 """A run: one of the models on a mesh, with its boundary parts, loads, data and damage law
 (:class:`Problem`). Your own problems are Problems; a thesis example of the catalogue is a
-Problem with its thesis metadata (:class:`damage_dolfinx.description.Example`). Run it with :func:`damage_dolfinx.run` (summary.json, XDMF, history.csv, checkpoints
+Problem with its thesis metadata (:class:`damage_dolfinx.problem.example.Example`). Run it with :func:`damage_dolfinx.run` (summary.json, XDMF, history.csv, checkpoints
 and restart, signals, figures, MPI) or study its convergence with :func:`damage_dolfinx.converge`.
 
 Example: the Kelvin-Voigt model with Tresca friction (``"2.2"``) on a rectangle clamped on the
@@ -30,14 +30,25 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Callable, Optional, Union
 
-from damage_dolfinx.parameters import InputError, ModelParameters, TimeGrid
+from damage_dolfinx.core.parameters import InputError, ModelParameters, TimeGrid
 
-#: more time steps than this need the parameter allow_long (--allow-long)
-MAX_STEPS = 10_000_000
+from damage_dolfinx.problem import stages
+from damage_dolfinx.problem.stages import MAX_STEPS, READINGS  # noqa: F401
 
-#: the readings of the thesis data (``--reading``); a problem without an evidence reading has
-#: evidence = literal
-READINGS = ("literal", "evidence")
+
+@dataclass
+class Figure:
+    """A PNG written at the end of a run: fields on the deformed configuration."""
+    filename: str
+    title: str
+    fields: tuple = ("von_mises", "zeta")
+    amplification: Optional[float] = None  # None: largest displacement = 10% of diameter
+    kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh),
+    #                                        "history" (fields = ((column, label), ...) of history.csv)
+    #                                        or "profiles" (summary "profiles" + zeta_probe, 3.3-ex2)
+    #                                        or "slices" (3-D: sections through the body, slices.py)
+    times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
+    mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
 
 
 @dataclass
@@ -147,7 +158,6 @@ class Problem:
 
     @cached_property
     def figures(self) -> list:
-        from damage_dolfinx.description import Figure
         return [Figure("fields_final.png", f"{self.name}: von Mises stress and damage")]
 
     # -- what a model reads of the problem it is built from
@@ -155,7 +165,7 @@ class Problem:
     def geometry(self):
         """The mesh as a :class:`~damage_dolfinx.geometries.Geometry` (a problem on one mesh:
         a Geometry or a ``(mesh, facet_tags)`` pair, as :meth:`build` gives it to the model)."""
-        from damage_dolfinx.meshes import as_geometry
+        from damage_dolfinx.problem.meshes import as_geometry
         if callable(self.mesh) and not isinstance(self.mesh, tuple):
             raise InputError(f"{self.name}: a mesh family has no geometry until it is built "
                              "(Problem.build or damage_dolfinx.run)")
@@ -169,7 +179,7 @@ class Problem:
     def k_max(self, comm=None) -> float:
         """The time-step limit of the scheme's explicit terms for this mesh and data (inf: none);
         a k above it is refused. Collective (runtime/limits.py)."""
-        from damage_dolfinx.runtime.limits import k_max
+        from damage_dolfinx.problem.limits import k_max
         return k_max(self, comm) if comm is not None else k_max(self)
 
     def parameters(self) -> ModelParameters:
@@ -201,7 +211,7 @@ class Problem:
         if self._checked:
             return self
         from damage_dolfinx.models.registry import model
-        from damage_dolfinx.validation import check_problem
+        from damage_dolfinx.problem.checks import check_problem
         problem = check_problem(self)  # every argument, before any work (validation.py)
         info = model(problem.model)
         params = problem.parameters()
@@ -241,9 +251,8 @@ class Problem:
         """The problem as one run has it (validated data, T, k, the mesh level and file), or
         InputError. ``overrides`` may name the reading (key ``reading``). ``comm``: the ranks of
         the run (default all), which the memory check is collective on."""
-        from damage_dolfinx.description import configure
         ex, overrides = self._resolved(overrides)
-        return configure(ex, n, k, T, h, overrides, mesh_file, comm)
+        return stages.configure(ex, n, k, T, h, overrides, mesh_file, comm)
 
     def default_k(self, n, h, T, params) -> float:
         """The time step when none is given for the run: the problem's own (an own problem's k
@@ -252,22 +261,20 @@ class Problem:
 
     def make_geometry(self, comm, n=None, h=None):
         """The problem's own mesh on ``comm`` (a family at level n)."""
-        from damage_dolfinx.meshes import as_geometry
+        from damage_dolfinx.problem.meshes import as_geometry
         return as_geometry(self.mesh(comm, n) if self.family else self.mesh, comm)
 
     def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
               configured=None):
         """The model of one run on ``comm`` (its mesh built); ``configured``: what
         :meth:`configure` returned for the same arguments (None: configured here)."""
-        from damage_dolfinx.description import build
-        return build(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
+        return stages.build(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
 
     def problem_data(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
                      configured=None) -> "Problem":
         """The configured problem on its mesh on ``comm``, checked: what a model is built from
         (no solver set up; the run fingerprint reads it)."""
-        from damage_dolfinx.description import on_mesh
-        return on_mesh(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
+        return stages.on_mesh(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
 
     def mesh_requirements(self):
         """(dimension, facet tags) a --mesh file must have (a catalogue example's)."""

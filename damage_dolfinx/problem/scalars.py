@@ -19,7 +19,7 @@ a built model's ``final`` block after a step, so that the two cannot drift apart
 """
 from __future__ import annotations
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 #: the scalars every model reports (Model.scalars)
 BASE_SCALARS = ("u_L2", "eps_u_L2", "zeta_min", "zeta_max", "zeta_mean")
@@ -34,7 +34,7 @@ def has_contact(model_class, problem, geometry, comm) -> bool:
     has a contact boundary Gamma_C (collective on ``comm``)."""
     import numpy as np
     from mpi4py import MPI
-    from damage_dolfinx.geometries import GAMMA_C
+    from damage_dolfinx.core.tags import GAMMA_C
     if not model_class.contact_roles:
         return False
     if problem.boundaries is not None:  # every named part is non-empty (meshes.retag)

@@ -33,7 +33,7 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
     the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
 
-    Raises (all importable from ``damage_dolfinx``; damage_dolfinx.errors):
+    Raises (all importable from ``damage_dolfinx``; damage_dolfinx.core.errors):
 
     * :class:`~damage_dolfinx.InputError`: bad input, refused before any work (one line; a
       folder holding a run without ``restart=True`` or ``overwrite=True``, a k above
@@ -47,7 +47,7 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     """
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.runner import run as _run
-    from damage_dolfinx.validation import check_run, communicator
+    from damage_dolfinx.core.validation import check_run, communicator
     with outcome(communicator("comm", comm)):
         checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out,
                             comm, on_step)
@@ -92,7 +92,7 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.loop import Run
     from damage_dolfinx.runtime.steps import Steps
-    from damage_dolfinx.validation import check_run, communicator
+    from damage_dolfinx.core.validation import check_run, communicator
     with outcome(communicator("comm", comm)):
         checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures,
                             out, comm)
@@ -124,7 +124,7 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart
     ``overwrite=False`` refuses a folder that holds a study."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    from damage_dolfinx.validation import check_converge, communicator
+    from damage_dolfinx.core.validation import check_converge, communicator
     with outcome(communicator("comm", comm)):
         n, k, ref_n, ref_k, T, restart, overwrite = check_converge(
             n, k, ref_n, ref_k, T, restart, overwrite, progress, out, comm)

@@ -1,5 +1,5 @@
 """The checks of a :class:`~damage_dolfinx.Problem`'s data, the second half of the validation
-layer (:mod:`damage_dolfinx.validation` holds the scalars and the other entry points'
+layer (:mod:`damage_dolfinx.core.validation` holds the scalars and the other entry points'
 arguments): ``check_problem`` before the mesh exists (types, ranges, the model's boundary roles
 and data), ``check_data`` once it does (the loads' and the damage law's UFL shapes against the
 mesh dimension, evaluated symbolically, and the initial damage at the mesh nodes). Failures
@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from damage_dolfinx.parameters import INFINITE_ALLOWED, InputError
-from damage_dolfinx.validation import (_shown, flag, is_real, mesh_path_problem, positive,
+from damage_dolfinx.core.parameters import INFINITE_ALLOWED, InputError
+from damage_dolfinx.core.validation import (_shown, flag, is_real, mesh_path_problem, positive,
                                        real, text, whole)
 
 
@@ -21,9 +21,9 @@ from damage_dolfinx.validation import (_shown, flag, is_real, mesh_path_problem,
 def check_problem(problem):
     """The problem with its scalars normalised (NumPy scalars to Python), or InputError.
     Called where the Problem is turned into a run (``Problem.checked``)."""
-    from damage_dolfinx.laws import DamageLaw
+    from damage_dolfinx.models.laws import DamageLaw
     from damage_dolfinx.models.registry import MODELS, model as model_class
-    from damage_dolfinx.parameters import ModelParameters
+    from damage_dolfinx.core.parameters import ModelParameters
     model = problem.model
     if isinstance(model, np.str_):
         model = str(model)
@@ -80,7 +80,7 @@ def check_problem(problem):
 
 
 def _check_mesh_argument(mesh):
-    from damage_dolfinx.geometries import Geometry
+    from damage_dolfinx.core.geometry import Geometry
     if isinstance(mesh, Geometry) or callable(mesh):
         return
     if isinstance(mesh, tuple):
@@ -182,7 +182,7 @@ def check_data(data):
     if errors:
         raise InputError(errors[0])
     if data.traction is not None:
-        from damage_dolfinx.meshes import tag_counts
+        from damage_dolfinx.problem.meshes import tag_counts
         from damage_dolfinx.models.registry import TRACTION
         if not tag_counts(data.geometry).get(TRACTION):
             raise InputError("traction is given but the mesh has no boundary part with the "
@@ -203,7 +203,7 @@ def _local_checks(data) -> tuple:
     """check_data's work on this rank alone: the shapes of the loads and the law, zeta0(x) at
     this rank's nodes; returns (non-finite count, min, max) of those values."""
     import ufl
-    from damage_dolfinx.laws import THESIS_A, THESIS_B
+    from damage_dolfinx.models.laws import THESIS_A, THESIS_B
     msh = data.geometry.mesh
     gdim = msh.geometry.dim
     x = ufl.SpatialCoordinate(msh)

@@ -1,6 +1,6 @@
 """The one validation layer of the public API (and of the command line, which maps onto it),
 first half: the scalars and the arguments of the entry points, each checked by its name
-(``ARGUMENTS``); a Problem's own data are checked in :mod:`damage_dolfinx.validation_problem`.
+(``ARGUMENTS``); a Problem's own data are checked in :mod:`damage_dolfinx.problem.checks`.
 Every argument of :class:`~damage_dolfinx.Problem`, :func:`~damage_dolfinx.run`,
 :func:`~damage_dolfinx.converge`, :func:`~damage_dolfinx.sweep`,
 :func:`~damage_dolfinx.read_mesh` and :func:`~damage_dolfinx.from_gmsh` is checked here for its
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 #: the largest sweep grid (points); larger grids are refused before any work
 MAX_SWEEP_POINTS = 10000
@@ -124,18 +124,6 @@ def mesh_path_problem(p: Path):
     if not p.is_file():
         return "is not a regular file"
     return None
-
-
-def check_problem(problem):
-    """The Problem's own checks (validation_problem.check_problem)."""
-    from damage_dolfinx.validation_problem import check_problem as check
-    return check(problem)
-
-
-def check_data(data):
-    """The Problem's data against its mesh (validation_problem.check_data)."""
-    from damage_dolfinx.validation_problem import check_data as check
-    return check(data)
 
 
 # ---------------------------------------------------------------------------- entry points

@@ -20,8 +20,9 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from damage_dolfinx.geometries import Geometry
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.geometry import Geometry
+from damage_dolfinx.core.tags import CONTACT_ROLES
+from damage_dolfinx.core.parameters import InputError
 
 
 def _check_model(dim):
@@ -33,7 +34,7 @@ def _check_model(dim):
                     "it holds no mesh")
         if dim is not None and d != dim:
             return f"it holds a {d}-D mesh; this problem is {dim}-D"
-        from damage_dolfinx.validation import cell_types_problem
+        from damage_dolfinx.core.validation import cell_types_problem
         mixed = cell_types_problem(gmsh, d)
         if mixed:
             return mixed
@@ -63,7 +64,7 @@ def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     """A gmsh ``.msh`` file as a :class:`~damage_dolfinx.geometries.Geometry` (mesh and facet
     tags), read on rank 0 and distributed over ``comm``. ``dim``: the dimension the problem
     needs (None: the file's). Raises InputError with the file name and what is wrong."""
-    from damage_dolfinx.validation import check_mesh_reading
+    from damage_dolfinx.core.validation import check_mesh_reading
     check_mesh_reading(path, dim, comm)
     path = Path(path)
     if path.suffix.lower() != ".msh":
@@ -88,10 +89,10 @@ def read_mesh(path, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
 def from_gmsh(model=None, comm=MPI.COMM_WORLD, dim=None) -> Geometry:
     """The mesh of a gmsh model (default: the current ``gmsh.model``, meshed, on rank 0)."""
     from damage_dolfinx import compat
-    from damage_dolfinx.runtime.signals import import_gmsh_keeping_sigint
+    from damage_dolfinx.compat.gmsh import import_gmsh_keeping_sigint
     import_gmsh_keeping_sigint()
     import gmsh
-    from damage_dolfinx.validation import check_dim, communicator
+    from damage_dolfinx.core.validation import check_dim, communicator
     check_dim(dim)
     communicator("comm", comm)
     model = model or gmsh.model
@@ -147,8 +148,6 @@ def tag_counts(geometry: Geometry) -> dict:
     return out
 
 
-#: the contact roles a boundary part may play (a model declares which of them it takes)
-CONTACT_ROLES = ("bilateral", "tresca", "coulomb", "normal_compliance")
 
 
 def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry:
@@ -157,7 +156,7 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
     they are. Every tag named (or ``required`` = {what: tag}) must be present and non-empty.
     ``model``: the model class, whose ``boundary_roles()`` are the roles allowed."""
     from damage_dolfinx import compat
-    from damage_dolfinx.geometries import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION
+    from damage_dolfinx.core.tags import GAMMA_C as CONTACT, GAMMA_D as CLAMPED, GAMMA_N as TRACTION
     counts = tag_counts(geometry)
     where = geometry.description or "the mesh"
     for what, tag in (required or {}).items():

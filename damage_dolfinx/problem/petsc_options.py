@@ -25,7 +25,7 @@ def _petsc_options(tokens, parser, command):
     word that is no PETSc option of the package's solvers (suggesting the double-dash option),
     an unknown double-dash option and a stray word."""
     from petsc4py import PETSc
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     given, i = {}, 0
     while i < len(tokens):
         tok = tokens[i]
@@ -72,7 +72,7 @@ def _check_petsc_values(given):
     work, with one line; the options are then set anew, so that whether a solver of the run
     reads them (``_unused``) is not confused by this check."""
     from petsc4py import PETSc
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     prefixes = set()
     for name in given:
         cut = [name.find(part) for part in _OBJECT_PARTS if name.find(part) > 0]

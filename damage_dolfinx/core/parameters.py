@@ -9,8 +9,7 @@ import math
 from dataclasses import dataclass, field
 
 
-class InputError(ValueError):
-    """Invalid user input; the CLI prints the message without a traceback."""
+from damage_dolfinx.core.errors import InputError  # noqa: F401 (defined with the others)
 
 
 @dataclass

@@ -55,7 +55,7 @@ def _default_vertices(ex) -> int:
 
 def check_memory(ex, n, h, comm):
     """Raise InputError when the estimated memory of a run exceeds what the job's hosts have."""
-    from damage_dolfinx.parameters import InputError
+    from damage_dolfinx.core.parameters import InputError
     scale = _scale(ex, n, h)
     if scale <= CHECK_ABOVE:
         return

@@ -12,10 +12,27 @@
 Messages name the arguments of the Python API (``restart=True``, ``write_every``); the command
 line prints them with its flags (:func:`for_command_line`: ``--restart``, ``--write-every``).
 """
-from damage_dolfinx.numerics.solvers import ConvergenceError
-from damage_dolfinx.parameters import InputError
-from damage_dolfinx.runtime.atomic import OutputError
-from damage_dolfinx.runtime.signals import RunInterrupted
+
+
+class InputError(ValueError):
+    """Invalid user input; the command line prints the message without a traceback."""
+
+
+class ConvergenceError(RuntimeError):
+    """A PETSc solver did not converge; the message names example, step, time and residual."""
+
+
+class OutputError(Exception):
+    """An output file could not be written (disk full, I/O error, folder deleted); one line."""
+
+
+class RunInterrupted(Exception):
+    """The run stopped on a signal after writing a checkpoint; exit status 128 + signal."""
+
+    def __init__(self, signum: int, message: str):
+        super().__init__(message)
+        self.signum, self.exit_status = signum, 128 + signum
+
 
 __all__ = ["InputError", "ConvergenceError", "OutputError", "RunInterrupted", "for_command_line"]
 

@@ -1,8 +1,7 @@
-"""The run description's stages and the catalogue's examples.
+"""The catalogue's examples: a thesis example is a :class:`~damage_dolfinx.Problem`
+(problem.py) that goes through the same stages (stages.py) and checks as a problem of your own.
 
-A run is a :class:`~damage_dolfinx.Problem` (problem.py). :func:`configure` decides the values
-of one run (validated data, time grid, mesh level and file) and :func:`build` builds its mesh on
-the run's ranks and the model from it. A catalogue example (:class:`Example`) is a Problem with
+A catalogue example (:class:`Example`) is a Problem with
 the thesis's metadata: section, readings with their departures, figures, default convergence
 study; the run machinery (``runtime/``) takes any Problem as it is, without knowing where it
 came from.
@@ -22,8 +21,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
-from damage_dolfinx.parameters import InputError, TimeGrid
-from damage_dolfinx.problem import MAX_STEPS, READINGS, Problem  # noqa: F401
+from damage_dolfinx.core.parameters import InputError, TimeGrid
+from damage_dolfinx.problem.problem import Figure, Problem  # noqa: F401 (Figure: the catalogue's)
+from damage_dolfinx.problem.stages import MAX_STEPS, READINGS  # noqa: F401
 
 
 #: the catalogue's short labels of its assumptions (a "G" and a number, with a slash-joined
@@ -44,21 +44,6 @@ def in_words(assumption: str) -> str:
     for pattern, words in _LABELS:
         assumption = pattern.sub(words, assumption)
     return assumption
-
-
-@dataclass
-class Figure:
-    """A PNG written at the end of a run: fields on the deformed configuration."""
-    filename: str
-    title: str
-    fields: tuple = ("von_mises", "zeta")
-    amplification: Optional[float] = None  # None: largest displacement = 10% of diameter
-    kind: str = "fields"                   # "fields" (final state), "mesh" (setting and mesh),
-    #                                        "history" (fields = ((column, label), ...) of history.csv)
-    #                                        or "profiles" (summary "profiles" + zeta_probe, 3.3-ex2)
-    #                                        or "slices" (3-D: sections through the body, slices.py)
-    times: tuple = ()                      # draw "fields" at these times (file name gets _t<t>)
-    mesh_lines: bool = False               # draw the deformed mesh edges ("deformed mesh" figures)
 
 
 @dataclass
@@ -102,7 +87,7 @@ class Example(Problem):
         base = self.literal or self
         r = base.readings.get(name, Reading()) if name != "literal" else Reading()
         label = "the default" if name == base.default_reading else "not the default"
-        from damage_dolfinx.departures import departures as _departures
+        from damage_dolfinx.core.departures import departures as _departures
         count = len(_departures(base.assumptions + r.assumptions))
         departures = (f"{count} departure(s) from the stated data, listed as R-entries and "
                       f"departure entries" if count else "no departure from the stated data")
@@ -127,7 +112,7 @@ class Example(Problem):
 
     def make_geometry(self, comm, n=None, h=None):
         """The example's own mesh at size n (structured) or h (gmsh) on ``comm``."""
-        from damage_dolfinx.meshes import as_geometry
+        from damage_dolfinx.problem.meshes import as_geometry
         return as_geometry(self.mesh(comm, n, h) if self.family else self.mesh, comm)
 
     def mesh_requirements(self):
@@ -172,85 +157,3 @@ class Example(Problem):
         names = {CLAMPED: "clamped (Gamma_D)", TRACTION: "traction (Gamma_N)",
                  CONTACT: "contact (Gamma_C)"}
         return {names[t]: t for t in (CLAMPED, TRACTION, CONTACT) if t in tags}
-
-
-def configure(ex: Problem, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
-              comm=None) -> Problem:
-    """``ex`` (under its reading) as one run has it: validated data, T, k, the mesh level and
-    file; InputError otherwise (see :meth:`Problem.configure`)."""
-    overrides = dict(overrides or {})
-    allow_long = bool(overrides.pop("allow_long", False))
-    from damage_dolfinx.models.registry import model as model_info, validate
-    info = model_info(ex.model)
-    # a time step you choose above k_max is refused (stability_check = error) unless the
-    # check is set explicitly (--allow-unstable sets warn); the thesis's own steps (defaults,
-    # convergence tables) run as the thesis ran them, with a warning above k_max
-    action = overrides.pop("stability_check", None) \
-        if "stability_check" not in ex.params.extra else overrides.get("stability_check")
-    if action is None:
-        action = "error" if (k is not None or ex.own) and not ex.allow_unstable \
-            else "warn"
-        if "stability_check" in ex.params.extra and k is not None:
-            overrides["stability_check"] = action
-    # validated once: a checked problem's data again only when a run changes them
-    params = ex.params if ex._checked and not overrides else \
-        validate(info, ex.params.replace(**overrides))
-    T = ex.T if T is None else float(T)
-    k = ex.default_k(n, h, T, params) if k is None else float(k)
-    time = TimeGrid(k, T)
-    k_max = info.k_max(params)
-    if k > k_max:
-        from damage_dolfinx.numerics.stability import check_time_step
-        check_time_step(k, k_max, f"{ex.id}: {info.stability_limit}", action=action)
-    if n is not None and ex.n is None:
-        raise InputError(f"example {ex.id} uses a gmsh mesh: set its size with --h, not --n")
-    if h is not None and ex.h is None:
-        raise InputError(f"example {ex.id} uses a structured mesh: set it with --n, not --h")
-    n = ex.n if n is None else int(n)
-    h = ex.h if h is None else float(h)
-    if n is not None and n < 1:
-        raise InputError(f"number of cells per side n must be >= 1, got n = {n}")
-    if h is not None and not h > 0:
-        raise InputError(f"mesh size h must be positive, got h = {h}")
-    if mesh_file is not None and not Path(mesh_file).is_file():
-        from damage_dolfinx.validation import mesh_path_problem
-        raise InputError(f"mesh file {str(mesh_file)!r} "
-                         f"{mesh_path_problem(Path(mesh_file)) or 'is not a file'}")
-    if time.num_steps > MAX_STEPS and not allow_long:
-        raise InputError(f"{time.num_steps} time steps (T = {T:g}, k = {k:g}) is more than "
-                         f"{MAX_STEPS:.0e}; choose a larger k, or allow_long=True")
-    if mesh_file is not None and ex.dim != 2:
-        raise InputError(f"--mesh reads 2-D gmsh meshes; example {ex.id} is {ex.dim}-D")
-    if mesh_file is None and not ex.own:
-        from mpi4py import MPI
-        from damage_dolfinx.runtime.resources import check_memory
-        # a mesh that cannot fit is refused now (collective on the run's ranks: a serial
-        # cell of a convergence study is built on one rank alone)
-        check_memory(ex, n, h, comm or MPI.COMM_WORLD)
-    sized = dict(n=n, h=h, mesh_file=str(mesh_file) if mesh_file is not None else None) \
-        if not ex.own else dict(n=n)
-    return dataclasses.replace(ex, params=params, T=T, k=k, _checked=True, **sized)
-
-
-def on_mesh(c: Problem, comm) -> Problem:
-    """The configured problem ``c`` on its mesh on ``comm`` (the problem's own, or the mesh file
-    replacing it, with the example's tags required), the boundary roles named, checked against
-    the loads, law and initial damage: what a model is built from (no solver set up)."""
-    from damage_dolfinx.meshes import read_mesh, retag
-    from damage_dolfinx.models.registry import model
-    from damage_dolfinx.validation import check_data
-    if c.mesh_file is not None:
-        geometry = read_mesh(c.mesh_file, comm, c.dim)
-        required = c.required_tags(comm)
-    else:
-        geometry = c.make_geometry(comm, c.n, c.h)
-        required = None
-    built = dataclasses.replace(c, mesh=retag(geometry, c.boundaries, required, model(c.model)))
-    check_data(built)  # loads, law, zeta0 against the mesh (validation.py)
-    return built
-
-
-def build(c: Problem, comm):
-    """The model of the configured problem ``c`` on ``comm``, built on :func:`on_mesh`."""
-    from damage_dolfinx.models.registry import model
-    return model(c.model)(on_mesh(c, comm))

@@ -11,7 +11,7 @@ import math
 
 import ufl
 
-from damage_dolfinx.numerics import constitutive3d
+from damage_dolfinx.forms import constitutive3d
 
 #: regulariser under the square root of the principal-strain formula (tension/compression split)
 SPLIT_EPS = 1e-30

@@ -46,7 +46,7 @@ class DamageLaw:
 
     def __init__(self, source: Callable, name: str = "user"):
         if not callable(source):
-            from damage_dolfinx.parameters import InputError
+            from damage_dolfinx.core.parameters import InputError
             raise InputError(f"a damage law needs a callable (eps, zeta, params) -> UFL, got {source!r}")
         self.source, self.name = source, str(name)
 

@@ -54,7 +54,7 @@ def norm_operators(V, Z) -> tuple:
     assembled once per model."""
     import ufl
     from damage_dolfinx import compat
-    from damage_dolfinx.numerics.constitutive import eps
+    from damage_dolfinx.forms.constitutive import eps
     du, w = ufl.TrialFunction(V), ufl.TestFunction(V)
     mats = [norm_matrix(compat.form(a), V.dofmap.index_map_bs)
             for a in (ufl.inner(du, w) * ufl.dx, ufl.inner(eps(du), eps(w)) * ufl.dx)]

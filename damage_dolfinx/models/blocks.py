@@ -43,10 +43,10 @@ from damage_dolfinx.forms.kelvin_voigt import (damaged_elastic_stress, kelvin_vo
                                                viscous_stress)
 from damage_dolfinx.forms.elastic_damage import load
 from damage_dolfinx.forms.viscoelastic_memory import total_stress as memory_stress
-from damage_dolfinx.laws import DamageLaw, thesis_law
+from damage_dolfinx.models.laws import DamageLaw, thesis_law
 from damage_dolfinx.numerics.boundary import bilateral_plane_faces as bilateral, clamped
-from damage_dolfinx.numerics.constitutive import B, Phi_L, eps, eta_star, von_mises
-from damage_dolfinx.numerics.contact import (normal_compliance_pressure, normal_compliance_term,
+from damage_dolfinx.forms.constitutive import B, Phi_L, eps, eta_star, von_mises
+from damage_dolfinx.forms.contact import (normal_compliance_pressure, normal_compliance_term,
                                              positive_part)
 from damage_dolfinx.numerics.damage import DamageStep
 from damage_dolfinx.numerics.friction import (FRICTION_DEFAULTS, OMEGA_PD, RHO_UZAWA,

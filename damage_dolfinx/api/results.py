@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from damage_dolfinx.parameters import InputError
+from damage_dolfinx.core.parameters import InputError
 
 
 @dataclass(frozen=True)
