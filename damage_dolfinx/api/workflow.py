@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from mpi4py import MPI
 
+from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS
+
 
 def _named(problem):
     """A catalogue id needs the catalogue loaded (it registers its ids with the run machinery,
@@ -15,7 +17,8 @@ def _named(problem):
 
 def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
         checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD,
-        on_step=None) -> dict:
+        on_step=None, h=None, overrides=None, mesh_file=None, write_every=None,
+        checkpoint_seconds=CHECKPOINT_SECONDS, history_every=None) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
     ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
     ``out/summary.json``).
@@ -30,8 +33,15 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     override the problem's own. ``fields.xdmf`` is one time series from t = 0 to the last step
     whatever restarts happened; :func:`~damage_dolfinx.read_run` reads the folder back.
     ``on_step(step)``: called after the initial state and after every step with the
-    :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
+    :class:`~damage_dolfinx.runtime.step.Step` (see :func:`steps`); a true return value stops
     the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
+
+    The command line's ``run`` calls this function with the same names: ``h`` (the element size
+    of a gmsh mesh family), ``overrides`` (changes to the problem's data for this run, e.g.
+    ``{"kappa": 2.0, "reading": "evidence"}``), ``mesh_file`` (a gmsh file replacing a
+    catalogue example's mesh), ``write_every`` (fields every that many steps), ``history_every``
+    (a history row every that many steps), ``checkpoint_every`` / ``checkpoint_seconds`` (a
+    checkpoint every that many steps, else every that many seconds of wall time; 0: none).
 
     Raises (all importable from ``damage_dolfinx``; damage_dolfinx.core.errors):
 
@@ -49,19 +59,20 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     from damage_dolfinx.runtime.runner import run as _run
     from damage_dolfinx.core.validation import check_run, communicator
     with outcome(communicator("comm", comm)):
-        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures, out,
-                            comm, on_step)
-        n, k, T, restart, overwrite = (checked[key] for key in ("n", "k", "T", "restart",
-                                                                 "overwrite"))
-        checkpoint_every, progress, figures = (checked[key] for key in (
-            "checkpoint_every", "progress", "figures"))
-        return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
-                    checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                    comm=comm, on_step=on_step)
+        checked = check_run(out, comm, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                            checkpoint_every=checkpoint_every, progress=progress,
+                            figures=figures, on_step=on_step, h=h, overrides=overrides,
+                            mesh_file=mesh_file, write_every=write_every,
+                            checkpoint_seconds=checkpoint_seconds, history_every=history_every)
+        checked.pop("comm", None)
+        return _run(_named(problem), out, comm=comm, **{k_: v for k_, v in checked.items()
+                                                        if k_ != "out"})
 
 
 def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD):
+          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD, h=None,
+          overrides=None, mesh_file=None, write_every=None,
+          checkpoint_seconds=CHECKPOINT_SECONDS, history_every=None):
     """The run of :func:`run` (the same arguments, the same run folder), step by step::
 
         with dd.steps(problem, "results/mine") as run:
@@ -70,7 +81,7 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
                 if R is not None and abs(R[1]) > 2.0:
                     break                          # the run stops here: status "stopped"
 
-    Each ``step`` (:class:`~damage_dolfinx.runtime.runner.Step`, after the initial state and
+    Each ``step`` (:class:`~damage_dolfinx.runtime.step.Step`, after the initial state and
     after every step) has ``n``, ``t``, the model and its live Functions ``u``, ``zeta``, ``v``
     (None where the scheme has none), ``contact_pressure`` (UFL, None without normal contact),
     ``contact_resultant()`` and the ``summary`` so far. Leaving the loop early stops the run at
@@ -94,19 +105,20 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
     from damage_dolfinx.runtime.steps import Steps
     from damage_dolfinx.core.validation import check_run, communicator
     with outcome(communicator("comm", comm)):
-        checked = check_run(n, k, T, restart, overwrite, checkpoint_every, progress, figures,
-                            out, comm)
-        n, k, T, restart, overwrite, checkpoint_every, progress, figures = (
-            checked[key] for key in ("n", "k", "T", "restart", "overwrite", "checkpoint_every",
-                                     "progress", "figures"))
-        run = Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
-                          overwrite=overwrite, checkpoint_every=checkpoint_every,
-                          progress=progress, figures=figures, comm=comm)
+        checked = check_run(out, comm, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
+                            checkpoint_every=checkpoint_every, progress=progress,
+                            figures=figures, h=h, overrides=overrides, mesh_file=mesh_file,
+                            write_every=write_every, checkpoint_seconds=checkpoint_seconds,
+                            history_every=history_every)
+        checked.pop("comm", None)
+        run = Run.prepare(_named(problem), out, comm=comm,
+                          **{k_: v for k_, v in checked.items() if k_ != "out"})
     return Steps(run, comm)
 
 
-def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart=False,
-             overwrite=True, comm=MPI.COMM_WORLD) -> dict:
+def converge(problem, out, *, n=None, k=None, ref_n=None, ref_k=None, T=None, progress=True,
+             restart=False, overwrite=True, comm=MPI.COMM_WORLD, overrides=None,
+             reference_ranks=None) -> dict:
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
     run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
     and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
@@ -121,15 +133,25 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart
     holding a study: nothing to do when it completed with these settings, else it runs again
     (studies keep no checkpoints); a study whose settings or run fingerprint at any level (mesh,
     loads, law, ... as a run's restart checks) differ is refused, naming what changed.
-    ``overwrite=False`` refuses a folder that holds a study."""
+    ``overwrite=False`` refuses a folder that holds a study. ``n``, ``k``, ``ref_n``, ``ref_k``
+    left None take a catalogue example's default study (a problem of your own has none: give
+    them). ``overrides``: changes to the problem's data, as for :func:`run`;
+    ``reference_ranks``: 1 (the reference serially, the coarse cells on the other ranks) or
+    "all" (None: the example's default, else 1). The command line's ``converge`` calls this
+    function."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    from damage_dolfinx.core.validation import check_converge, communicator
+    from damage_dolfinx.core.validation import changes, check_converge, communicator
     with outcome(communicator("comm", comm)):
         n, k, ref_n, ref_k, T, restart, overwrite = check_converge(
             n, k, ref_n, ref_k, T, restart, overwrite, progress, out, comm)
+        overrides = changes("overrides", overrides)
+        if reference_ranks not in (None, 1, "all"):
+            from damage_dolfinx.core.errors import InputError
+            raise InputError(f"reference_ranks must be 1, 'all' or None, got {reference_ranks!r}")
         return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
-                     progress=progress, comm=comm, restart=restart, overwrite=overwrite)
+                     progress=progress, comm=comm, restart=restart, overwrite=overwrite,
+                     overrides=overrides, reference_ranks=reference_ranks)
 
 
 def gather(function):

@@ -31,30 +31,31 @@ def command(argv, comm, given):
                 reading = f" (reading: {ex.reading})" if ex.readings else ""
                 print(f"{ex.id:10s} [Section {ex.section}] {ex.title}{reading}")
         return 0
+    # every command is a client of the public API: the same entry points and checks a script
+    # meets (damage_dolfinx.api.workflow; core.validation checks each argument by its name)
+    from damage_dolfinx.api import workflow
     if args.command == "run":
-        from damage_dolfinx.runtime import runner
-        runner.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
-                   overrides=_overrides(args.set, args.friction_solver, args.friction_law,
-                                        args.reading, args),
-                   mesh_file=args.mesh,
-                   write_every=args.write_every, progress=not args.quiet,
-                   figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
-                   checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
-                   overwrite=args.overwrite, history_every=args.history_every)
+        workflow.run(args.id, args.out, n=args.n, k=args.k, T=args.T, h=args.h,
+                     overrides=_overrides(args.set, args.friction_solver, args.friction_law,
+                                          args.reading, args),
+                     mesh_file=args.mesh,
+                     write_every=args.write_every, progress=not args.quiet,
+                     figures=not args.no_figures, checkpoint_every=args.checkpoint_every,
+                     checkpoint_seconds=args.checkpoint_seconds, restart=args.restart,
+                     overwrite=args.overwrite, history_every=args.history_every, comm=comm)
     elif args.command == "sweep":
         status = _sweep(args)
         if status:
             return status
     elif args.command == "converge":
-        from damage_dolfinx.studies import convergence
-        convergence.study(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
-                          ns=args.n, ks=args.k, T=args.T,
+        workflow.converge(args.id, args.out, ref_n=args.ref_n, ref_k=args.ref_k,
+                          n=args.n, k=args.k, T=args.T,
                           overrides=_overrides(args.set, args.friction_solver,
                                                args.friction_law, args.reading, args),
                           progress=not args.quiet,
                           reference_ranks={"1": 1, "all": "all", None: None}[
                               args.reference_ranks],
-                          restart=args.restart, overwrite=args.overwrite)
+                          restart=args.restart, overwrite=args.overwrite, comm=comm)
     unused = _unused(given, comm)
     if unused and comm.rank == 0:
         print(f"damage-dolfinx: warning: no solver of this {args.command} read the PETSc "
@@ -64,8 +65,9 @@ def command(argv, comm, given):
 
 
 def _sweep(args):
+    from damage_dolfinx.api.workflow import sweep
     from damage_dolfinx.core.parameters import InputError
-    from damage_dolfinx.studies.sweep import parse_values, sweep
+    from damage_dolfinx.studies.sweep import parse_values
     if not args.set:
         raise InputError("sweep needs at least one --set NAME=V1,V2,...")
     grid = {}

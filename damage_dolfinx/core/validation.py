@@ -146,14 +146,40 @@ def _maybe(check):
     return lambda name, value: check(name, value, allow_none=True)
 
 
+def changes(name, value):
+    """A run's changes to the problem's data: a dict of names to values, or None."""
+    if value is not None and (not isinstance(value, dict) or
+                              not all(isinstance(key, str) and key for key in value)):
+        raise InputError(f"{name} must be a dict of parameter names to values, got "
+                         f"{_shown(value)} ({type(value).__name__})")
+    return None if value is None else dict(value)
+
+
+def seconds(name, value):
+    """A wall-time interval: a finite number >= 0 (0: never)."""
+    if not is_real(value) or not math.isfinite(float(value)) or float(value) < 0:
+        raise InputError(f"{name} must be a finite number >= 0 (0: none), got {_shown(value)}")
+    return float(value)
+
+
+def mesh_file_path(name, value):
+    if value is None:
+        return None
+    if not isinstance(value, (str, Path)) or not str(value):
+        raise InputError(f"{name} must be a gmsh .msh file path, got {_shown(value)}")
+    return value
+
+
 #: every keyword argument of the entry points (run, steps, converge, sweep, read_mesh,
 #: from_gmsh), checked by its name: one rule per name, whichever function takes it
 ARGUMENTS = {
     "out": path, "n": _maybe(whole), "k": _maybe(positive), "T": _maybe(positive),
     "restart": flag, "overwrite": flag, "progress": flag, "figures": flag,
     "checkpoint_every": _maybe(whole), "max_points": _maybe(whole),
+    "h": _maybe(positive), "write_every": _maybe(whole), "history_every": _maybe(whole),
+    "checkpoint_seconds": seconds, "overrides": changes, "mesh_file": mesh_file_path,
     "plot": _maybe(text), "comm": communicator, "on_step": callback,
-    "ref_n": whole, "ref_k": positive,
+    "ref_n": _maybe(whole), "ref_k": _maybe(positive),
     "ranks_per_point": _maybe(whole),
     "point": lambda name, value: whole(name, value, low=0, allow_none=True),
 }
@@ -165,13 +191,11 @@ def arguments(**given) -> dict:
     return {name: ARGUMENTS[name](name, value) for name, value in given.items()}
 
 
-def check_run(n=None, k=None, T=None, restart=False, overwrite=False, checkpoint_every=None,
-              progress=True, figures=True, out=None, comm=None, on_step=None):
-    """The arguments of run() and steps() besides the problem."""
+def check_run(out=None, comm=None, **given):
+    """The arguments of run() and steps() besides the problem (the command line's run passes
+    the same ones: this is the only place they are checked)."""
     extra = {} if comm is None else {"comm": comm}
-    return arguments(out=out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
-                     checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                     on_step=on_step, **extra)
+    return arguments(out=out, **given, **extra)
 
 
 def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True, progress=True,
@@ -183,7 +207,8 @@ def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True, progres
         extra["out"] = out
     rest = arguments(ref_n=ref_n, ref_k=ref_k, T=T, restart=restart, overwrite=overwrite,
                      progress=progress, **extra)
-    return (levels("n", n, whole), levels("k", k, positive), rest["ref_n"], rest["ref_k"],
+    return (None if n is None else levels("n", n, whole),
+            None if k is None else levels("k", k, positive), rest["ref_n"], rest["ref_k"],
             rest["T"], rest["restart"], rest["overwrite"])
 
 

@@ -4,7 +4,6 @@ generic time loop (any model) and yields a :class:`~damage_dolfinx.runtime.runne
 the initial state and after every step. What a step writes is in records.py."""
 from __future__ import annotations
 
-import math
 import sys
 import time
 from pathlib import Path
@@ -36,20 +35,10 @@ class Run(RunRecords):
         """Everything refused before any work (see :func:`run`)."""
         ex = resolve(case, overrides)
         configured = ex.configure(n, k, T, h, overrides, mesh_file, comm)
+        # the arguments were checked by the entry point (core.validation.check_run), the
+        # parameter history_every with the data (core.parameters.EXTRA_RULES)
         every = history_every if history_every is not None else \
             configured.params.extra.get("history_every", 1)
-        if isinstance(every, bool) or not isinstance(every, (int, float)) or every != int(every) \
-                or every < 1:
-            raise InputError(f"history_every must be a whole number >= 1, got {every!r}")
-        for name, value in (("write_every", write_every),
-                            ("checkpoint_every", checkpoint_every)):
-            if value is not None and (isinstance(value, bool) or not isinstance(value, int)
-                                      or value < 1):
-                raise InputError(f"{name} must be a whole number >= 1, got {value!r}")
-        if not (isinstance(checkpoint_seconds, (int, float)) and checkpoint_seconds >= 0
-                and math.isfinite(checkpoint_seconds)):
-            raise InputError(f"checkpoint_seconds must be a finite number >= 0 (0: none), "
-                             f"got {checkpoint_seconds!r}")
         if mesh_file is not None:
             check_mesh_file(mesh_file, ex.dim, lambda: ex.mesh_requirements()[1], comm=comm)
         if restart and not Path(out).is_dir():
