@@ -39,7 +39,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "bar_obstacle"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "bar_obstacle"
 length, height = 2.0, 0.25
 geometry = rectangle(comm, (0.0, 0.0), (length, height), 16, 2, {3: side(0, length)})
 

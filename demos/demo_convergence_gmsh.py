@@ -37,7 +37,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.plate_with_hole import plate_with_hole_family
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "convergence_gmsh"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "convergence_gmsh"
 
 problem = dd.Problem(
     model="2.1", mesh=plate_with_hole_family(h0=0.4), n=1, T=0.4, name="plate with a hole",

@@ -39,7 +39,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "convergence_study"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "convergence_study"
 
 
 def strip(comm, n):

@@ -43,7 +43,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "dragged_block"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "dragged_block"
 geometry = rectangle(comm, (0.0, 0.0), (2.0, 0.5), 16, 4,
                      {1: side(0, 0.0), 2: side(0, 2.0), 3: side(1, 0.0)})
 

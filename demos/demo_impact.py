@@ -42,7 +42,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "impact"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "impact"
 width, height = 2.0, 0.5
 geometry = rectangle(comm, (0.0, 0.0), (width, height), 16, 4, {3: side(1, 0.0)})
 

@@ -46,7 +46,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries import gmsh_session
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "notched_plate"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "notched_plate"
 
 gmsh = gmsh_session()
 if comm.rank == 0:

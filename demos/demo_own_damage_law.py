@@ -45,7 +45,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "own_damage_law"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "own_damage_law"
 
 
 def strip(comm, n):

@@ -117,7 +117,7 @@ class CompliantKelvinVoigt(dd.Model):
 # :math:`(0, -3 q t x^2)` on its top (tag 2): the total load is :math:`q t`.
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "own_model"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "own_model"
 Q_LOAD = 40.0
 
 

@@ -46,7 +46,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "relaxation"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "relaxation"
 
 
 def bar(comm, n):

@@ -40,7 +40,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "sliding_block"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "sliding_block"
 width, height = 2.0, 0.5
 geometry = rectangle(comm, (0.0, 0.0), (width, height), 16, 4, {3: side(1, 0.0)})
 

@@ -47,7 +47,7 @@ import damage_dolfinx as dd
 from damage_dolfinx.geometries.rectangle import rectangle, side
 
 comm = MPI.COMM_WORLD
-out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", ".")) / "viscoplastic_bar"
+out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "viscoplastic_bar"
 length, height = 4.0, 1.0
 geometry = rectangle(comm, (0.0, 0.0), (length, height), 16, 4,
                      {1: side(0, 0.0), 2: side(0, length), 3: side(1, 0.0)})
