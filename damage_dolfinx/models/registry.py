@@ -18,6 +18,7 @@ ROLES = ("clamped", "traction") + CONTACT_ROLES
 
 #: the modules under damage_dolfinx/models/ holding the catalogue's models, in catalogue order
 MODULES = ("elastic_2_1", "bridge_2_1", "kelvin_voigt_2_2", "memory_2_3", "viscoplastic_2_4",
+           "viscoplastic_compliance_2_4",
            "dynamic_3_1", "dynamic_tresca_3_2", "fully_damageable_3_3")
 
 _registered: dict = {}

@@ -72,55 +72,83 @@ class ElastoViscoplasticFriction(Model):
         return params
 
     def __init__(self, data):
+        """The model from its parts, each one named: a variant overrides the part it changes
+        (a 2.4 body on a normal-compliance foundation replaces only :meth:`increment_step`)."""
         super().__init__(data)
-        p, msh, x = self.params, self.mesh, data.params.extra
-        V, Z, Q = compat.vector_p1(msh), compat.scalar_p1(msh), compat.tensor_dg0(msh)
-        self.u, self.u_old = fem.Function(V, name="u"), fem.Function(V, name="u_old")
-        self.w = fem.Function(V, name="du")  # delta u_n = (u_n - u_{n-1}) / k
-        self.sigma, self.sigma_old = fem.Function(Q, name="sigma"), fem.Function(Q, name="sigma_old")
-        self.G_hat = fem.Function(Q, name="G_hat")
-        self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
         self.k = data.time.k
-        k = fem.Constant(msh, self.k)
-        law = x["friction_law"]
-        tags = data.geometry.facet_tags
-        ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
-        normal = ufl.FacetNormal(msh)
-
-        # (1) and (3): cell-wise (DG0) updates, exact projections onto Q^h
-        self._G_expr = compat.expression(
-            viscoplastic_rate(self.sigma_old, self.zeta_old, p.L_trunc, x["viscoplastic_sign"]), Q)
-        self._sigma_expr = compat.expression(
-            stress_update(self.sigma_old, self.w, self.G_hat, k, p.E, p.nu), Q)
-
-        # (2) increment second-kind VI
-        f_B, f_N = self.loads()
-        S_n = fem.Constant(msh, float(x["S_n"])) if law == "coulomb" else None
-        a, l = increment_step_forms(ufl.TrialFunction(V), ufl.TestFunction(V), self.sigma_old,
-                                    self.G_hat, k, p.E, p.nu, f_B, f_N, ds(GAMMA_N), S_n, normal,
-                                    ds(GAMMA_C))
-        bcs = [clamped(V, tags, GAMMA_D)]
-        if law == "tresca" or x["coulomb_normal"] == "bilateral":
-            bcs += bilateral_plane_faces(V, tags, GAMMA_C)
-        g = fem.Constant(msh, float(x["g_fric"] if law == "tresca" else x["mu_f"] * abs(x["S_n"])))
-        self.friction_problem = FrictionProblem(self.w, a, l, bcs, g, ds(GAMMA_C), self.context)
-        self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
-                                               data.id)
-
+        self.tags = data.geometry.facet_tags
+        self.ds = ufl.Measure("ds", domain=self.mesh, subdomain_data=self.tags)
+        self.spaces()
+        self.explicit_updates()                      # (1) and (3)
+        self.increment = self.increment_step()       # (2)
         # (4) damage obstacle step, source from step n-1 (variant A, no sigma dependence:
         # docs/models.md, section 2.4)
         self.damage = self.obstacle_damage_step()
+        self.outputs()
 
+    # -- the parts
+    def spaces(self):
+        """P1 displacement u, its increment w = (u_n - u_{n-1})/k and damage zeta; DG0 (Q^h)
+        stresses sigma and the viscoplastic rate Ghat; the old state of the step."""
+        msh = self.mesh
+        self.V, Z, self.Q = compat.vector_p1(msh), compat.scalar_p1(msh), compat.tensor_dg0(msh)
+        self.u, self.u_old = fem.Function(self.V, name="u"), fem.Function(self.V, name="u_old")
+        self.w = fem.Function(self.V, name="du")  # delta u_n = (u_n - u_{n-1}) / k
+        self.sigma = fem.Function(self.Q, name="sigma")
+        self.sigma_old = fem.Function(self.Q, name="sigma_old")
+        self.G_hat = fem.Function(self.Q, name="G_hat")
+        self.zeta, self.zeta_old = fem.Function(Z, name="zeta"), fem.Function(Z, name="zeta_old")
+
+    def explicit_updates(self):
+        """(1) and (3): cell-wise (DG0) updates, exact projections onto Q^h."""
+        p, x = self.params, self.params.extra
+        self._G_expr = compat.expression(
+            viscoplastic_rate(self.sigma_old, self.zeta_old, p.L_trunc, x["viscoplastic_sign"]),
+            self.Q)
+        self._sigma_expr = compat.expression(
+            stress_update(self.sigma_old, self.w, self.G_hat, fem.Constant(self.mesh, self.k),
+                          p.E, p.nu), self.Q)
+
+    def increment_forms(self, w, S_n=None):
+        """(a, l) of the increment step (2.187) without its contact term, in ``w`` (a trial
+        function, or the increment itself for a nonlinear residual)."""
+        p, msh = self.params, self.mesh
+        f_B, f_N = self.loads()
+        return increment_step_forms(w, ufl.TestFunction(self.V), self.sigma_old, self.G_hat,
+                                    fem.Constant(msh, self.k), p.E, p.nu, f_B, f_N,
+                                    self.ds(GAMMA_N), S_n, ufl.FacetNormal(msh),
+                                    self.ds(GAMMA_C))
+
+    def increment_step(self) -> SubStep:
+        """(2): the increment second-kind VI with Tresca (P1) or simplified Coulomb (P2)
+        friction, by a friction solver (prefix ``friction_``)."""
+        msh, x, tags = self.mesh, self.params.extra, self.tags
+        law = x["friction_law"]
+        S_n = fem.Constant(msh, float(x["S_n"])) if law == "coulomb" else None
+        a, l = self.increment_forms(ufl.TrialFunction(self.V), S_n)
+        bcs = [clamped(self.V, tags, GAMMA_D)]
+        if law == "tresca" or x["coulomb_normal"] == "bilateral":
+            bcs += bilateral_plane_faces(self.V, tags, GAMMA_C)
+        g = fem.Constant(msh, float(x["g_fric"] if law == "tresca" else x["mu_f"] * abs(x["S_n"])))
+        self.friction_problem = FrictionProblem(self.w, a, l, bcs, g, self.ds(GAMMA_C),
+                                                self.context)
+        self.friction = solver_from_parameters(self.friction_problem, x, tags, GAMMA_D,
+                                               self.data.id)
+        return SubStep("friction", "newton", "friction_", self._friction, its=("snes_its",))
+
+    def outputs(self):
+        """The von Mises stress, ||sigma||_Q, the contact nodes and the error components."""
+        msh, x = self.mesh, self.params.extra
         self.von_mises = fem.Function(compat.scalar_dg0(msh), name="von_mises")
         self._vm_expr = compat.expression(von_mises(self.sigma), self.von_mises.function_space)
         self._stress_sq = bookkeeping.PiecewiseConstantNorm(self.sigma)  # sigma_n: DG0
-        self._contact_dofs = self._gamma_c_dofs(V, tags)
+        self._contact_dofs = self._gamma_c_dofs(self.V, self.tags)
         self.output_fields = [self.u, self.zeta, self.von_mises, self.sigma]
         self.error_components = [("u", self.u, "V"), ("sigma", self.sigma, "L2"),
                                  ("zeta", self.zeta, "L2")]  # e_hk of Section 2.4.3
         if x.get("stress_in_error", "yes") == "no":  # e_hk without ||sigma||_Q
             self.error_components = [c for c in self.error_components if c[0] != "sigma"]
-        self.timings = {"damage": 0.0, "friction": 0.0, "stress": 0.0}
+        self.timings = {"damage": 0.0, self.increment.name: 0.0, "stress": 0.0}
 
     @staticmethod
     def _gamma_c_dofs(V, tags):
@@ -134,14 +162,17 @@ class ElastoViscoplasticFriction(Model):
     def scheme(self) -> tuple:
         """In the order of (2.184)-(2.187): the explicit updates (3) of u and sigma are the
         sub-step ``stress``, before the damage step (4) (which reads u_{n-1} and zeta_{n-1})."""
-        return (SubStep("friction", "newton", "friction_", self._friction, its=("snes_its",)),
+        return (self.increment,                                                 # (1), (2)
                 SubStep("stress", "update", "", self._stress),
                 SubStep("damage", "snes-vi", "damage_", self.damage.solve,          # (4)
                         its=("damage_its",)))
 
     def _friction(self) -> int:
-        compat.interpolate(self.G_hat, self._G_expr)                       # (1)
+        self._rate()                                                       # (1)
         return self.friction.solve()                                       # (2)
+
+    def _rate(self):
+        compat.interpolate(self.G_hat, self._G_expr)                       # (1)
 
     def _stress(self):
         self.u.x.array[:] = self.u_old.x.array + self.k * self.w.x.array  # (3)
@@ -156,13 +187,17 @@ class ElastoViscoplasticFriction(Model):
         out = super().scalars()
         out["zeta_min_x"], out["zeta_min_y"] = self._most_damaged_point()
         out["stress_Q"] = float(np.sqrt(self.comm.allreduce(self._stress_sq.local())))
-        if self.mesh.topology.dim == 3:  # |u_tau| at the contact nodes (3-D)
-            u1 = law.norm(self.friction.nodes.tangential(self.u))
-        else:
-            u1 = self.u.x.array.reshape(-1, 2)[self._contact_dofs, 0]  # Gamma_C is horizontal here
+        u1 = self.tangential_displacement()
         out["slip_max"] = float(self.comm.allreduce(np.abs(u1).max() if u1.size else 0.0,
                                                     op=MPI.MAX))
         return out
+
+    def tangential_displacement(self):
+        """|u_tau| at the owned and ghost contact nodes (the friction solver's nodes in 3-D;
+        u_1 in 2-D, where Gamma_C is horizontal)."""
+        if self.mesh.topology.dim == 3:
+            return law.norm(self.friction.nodes.tangential(self.u))
+        return self.u.x.array.reshape(-1, 2)[self._contact_dofs, 0]
 
     def _most_damaged_point(self):
         n_owned = self.zeta.function_space.dofmap.index_map.size_local
