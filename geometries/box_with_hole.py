@@ -4,9 +4,9 @@ The 3-D counterpart of ``square_with_hole`` (Section 2.1 Example 1): an n x n x 
 hexahedra, each cut into the 6 tetrahedra of DOLFINx's ``create_box``, without the hexahedra of
 the hole (meshes with n and 2n are nested). The cells and vertices outside the hole are built
 directly, each rank a slab of layers, and handed to ``create_mesh``: linear in the cells (cutting
-the hole out of the full box with DOLFINx 0.5.2's ``create_submesh`` grew superlinearly, 65 s at
-n = 45). Gamma_D is the hole's boundary, Gamma_N the outer boundary; optional Gamma_C faces
-(bilateral contact) by a marker.
+the hole out of the full box with DOLFINx 0.5.2's ``create_submesh`` grew superlinearly;
+benchmarks/README.md, "Why the defaults"). Gamma_D is the hole's boundary, Gamma_N the outer
+boundary; optional Gamma_C faces (bilateral contact) by a marker.
 
 * cavity ``hole_z = (2, 3)`` in a cube (side = height = 5): the 3-D example 2.1-ex1-3d;
 * ``hole_z = None``: a hole through the whole height, i.e. the plate of thickness ``height``

@@ -4,7 +4,8 @@ The n x n grid of squares, each cut along its diagonal 'right' into the two tria
 DOLFINx's ``create_rectangle``, without the squares of the hole; meshes with n and 2n are
 therefore nested. The cells and vertices outside the hole are built directly, each rank a slab of
 rows, and handed to ``create_mesh``: linear in the cells (cutting the hole out of the full grid
-with DOLFINx 0.5.2's ``create_submesh`` grew like N^1.9, 340 s at 10^6 unknowns). Gamma_D is
+with DOLFINx 0.5.2's ``create_submesh`` grew faster than linearly; benchmarks/README.md, "Why the
+defaults"). Gamma_D is
 the hole boundary, Gamma_N the outer boundary.
 """
 import math

@@ -1,5 +1,5 @@
 """3-D contact: wall times of the 3-D contact examples at their defaults, and the
-direct/AMG crossover of the 3.1 velocity system (benchmarks/README.md "3-D: contact").
+direct/AMG crossover of the 3.1 velocity system (benchmarks/README.md "3-D scaling").
 
     .venv/bin/python benchmarks/studies/contact_3d.py [--examples] [--crossover]
 

@@ -111,7 +111,7 @@ def examples():
             "friction solvers: Newton (default) and penalty-duality agree (4.9e-7 relative in u "
             "at t = 0.4); Uzawa is refused: although the mass "
             "term makes a coercive, the ||eps(.)|| stopping test of friction.py does not see "
-            "rigid translations (measured: stops after one iteration at n = 4, never at n = 20)"],
+            "rigid translations (in runs: it stops after one iteration at n = 4, never at n = 20)"],
         figures=[Figure("figure_3_10.png", "Example 3.2-2: setting and mesh", kind="mesh"),
                  Figure("figure_3_11.png", "Example 3.2-2: deformed mesh", fields=("zeta",),
                         amplification=5.0, mesh_lines=True),

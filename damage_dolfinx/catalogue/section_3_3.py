@@ -14,8 +14,7 @@ from damage_dolfinx.core.parameters import ModelParameters
 #: dividing T, from stability.py (undamaged body, Gamma_C fully in contact; see the assumptions)
 K_EX2 = 6.25e-5
 #: Example 3: 0.8 k_max (k_max = 1.3662e-5 at h = 0.15) rounded down to a divisor of T = 6.5,
-#: 594 703 steps: the k of benchmarks/studies/wrench_3_3.py and of its committed reference (
-#: the wrench keeps k = 0.8 k_max; it was 1e-5 = 0.73 k_max, 650 000 steps, until then)
+#: 594 703 steps: the k of benchmarks/studies/wrench_3_3.py and of its committed reference
 K_EX3 = 6.5 / 594_703
 #: The wrench writes a history.csv row every 50 steps (5e-4 s at k = 1e-5; about
 #: 13 000 rows for T = 6.5 instead of 650 000); the maximal interpenetration of summary.json is
@@ -96,8 +95,8 @@ def examples():
             "'L2 errors'); the thesis's table is not set beside ours",
             "1.8: with m_visc = 1 the explicit terms are harmless: k_max = 1.14 (n = 8), 0.73 "
             "(n = 128) from stability.py, far above the largest k = 0.1 of the table; the check "
-            "is therefore off by default (it costs ~27 s per build at n = 128, and a convergence "
-            "study builds 37 steppers); --set stability_check=warn to compute it",
+            "is therefore off by default (its eigensolves are costly at n = 128, and a "
+            "convergence study builds 37 steppers); --set stability_check=warn to compute it",
             "default run n = 16, k = 0.01 (a cell of the table)"],
         figures=[Figure("figure_3_15.png", "Example 3.3-1: setting and mesh", kind="mesh"),
                  Figure("fields_final.png", "Example 3.3-1: von Mises stress and damage")],

@@ -14,7 +14,7 @@ from damage_dolfinx.core.parameters import ModelParameters
 
 #: 3-D contact examples (benchmarks/reference_output/contact_3d/): default mesh sizes and
 #: time steps; the k of the explicit dynamic schemes is at most 0.8 k_max of stability.py at the
-#: default mesh (measured, listed in each entry's assumptions)
+#: default mesh (computed, listed in each entry's assumptions)
 N_2_3_EX1, N_3_1_EX1, N_3_3_EX1 = 8, 12, 12
 K_3_1_EX1 = 0.01
 #: the wrench plate: gmsh size h (h/2 on the hexagon faces), time step, default final time
@@ -186,7 +186,7 @@ def contact_examples():
             f"1.8/G33: k = {K_3_3_EX3:g}, at most 0.8 k_max of stability.py at the default mesh "
             "(k_max in summary.json)",
             f"final time T = {T_3_3_EX3:g} by default (the thesis' T = 6.5 is 650 000 explicit "
-            "steps: --T 6.5 runs it; benchmarks/reference_output/contact_3d/examples.md gives the measured "
+            "steps: --T 6.5 runs it; benchmarks/reference_output/contact_3d/examples.md gives the "
             "cost per step)",
             "solvers: as in 2-D (velocity CG + Jacobi with the fast matrix update in serial; "
             "damage obstacle step SNES vinewtonrsls, CG + Jacobi)"],

@@ -35,9 +35,9 @@ _SINGLETON_SETTINGS = {"OMPI_MCA_btl": "^ofi,uct", "OMPI_MCA_pml": "ob1",
 def _start_mpi():
     """MPI_Init (the import of mpi4py.MPI). A command that no MPI launcher started is one rank
     alone and talks to no other process, yet Open MPI starts a daemon for it and probes every
-    network transport: on Open MPI 4.1 here MPI_Init took 0.38 s, 0.17 s without the probes of
-    libfabric's providers and UCX, 0.05 s without the daemon (the probes take about 1 s under
-    Open MPI 6). Such a process starts with _SINGLETON_SETTINGS, for MPI_Init only: a value
+    network transport, which makes MPI_Init several times slower than it needs to be
+    (benchmarks/README.md, "Why the defaults"). Such a process starts with _SINGLETON_SETTINGS,
+    for MPI_Init only: a value
     set outside is kept, and the variables are taken out again (a process it starts does not
     inherit them). Other MPI libraries ignore them."""
     added = {} if any(v in os.environ for v in _LAUNCHER_VARIABLES) else \

@@ -10,7 +10,8 @@ def import_gmsh_keeping_sigint():
     """gmsh's Python module sets SIGINT to its default action (killing the process, with no
     line and no status) when it is first imported: import it now, if it is there, and put the
     handler back. Every import of gmsh in the package goes through here, where gmsh is first
-    needed (it costs about 0.3 s, which a run on a built-in mesh does not pay)."""
+    needed (its import takes a noticeable part of a small run's start, which a run on a
+    built-in mesh does not pay)."""
     import sys
     if "gmsh" in sys.modules or threading.current_thread() is not threading.main_thread():
         return
@@ -28,8 +29,8 @@ _gmsh_ready = False
 
 
 class _LazyGmsh:
-    """The gmsh module, imported on first use: importing it costs about 0.3 s, which a run on
-    a built-in mesh never needs (the geometry modules are imported with the catalogue)."""
+    """The gmsh module, imported on first use: its import is slow, and a run on a built-in
+    mesh never needs it (the geometry modules are imported with the catalogue)."""
 
     def __getattr__(self, name):
         return getattr(_gmsh(), name)

@@ -165,10 +165,10 @@ class BridgeDamage(RingSections, ElasticDamage):
 
     def _lagged_direct_mech(self):
         """3-D vault: the elasticity by CG on a lagged LU factorisation (the 2-D default) instead
-        of scalable.py's CG + GAMG: at nu = 0.49 GAMG needed 100-140 CG iterations per step and
-        broke down near collapse (DIVERGED_INDEFINITE_PC at step 30, W = 1 m, h = 0.1); lagged
-        LU is about 4x faster per step at that size (40 000 dofs). -mech_pc_type gamg (with
-        the other -mech_* options) still selects AMG."""
+        of scalable.py's CG + GAMG: at nu = 0.49 GAMG needs many CG iterations per step and broke
+        down near collapse (DIVERGED_INDEFINITE_PC, W = 1 m, h = 0.1); lagged LU is several times
+        faster per step at that size (benchmarks/README.md, "Why the defaults"). -mech_pc_type
+        gamg (with the other -mech_* options) still selects AMG."""
         from damage_dolfinx.numerics import scalable
         from damage_dolfinx.numerics.solvers import LAGGED_DIRECT, LinearSolver
         from damage_dolfinx.models.elastic_2_1 import MECH_REFACTOR_ITS

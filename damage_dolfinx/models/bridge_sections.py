@@ -12,7 +12,7 @@ each hinge the face with the lower zeta (intrados or extrados) is reported: with
 damage that is the face that opens. The thresholds are conventions, not calibrated to a count.
 
 Mechanism: a peak of D_j marks damage, not motion (self weight alone leaves four symmetric
-peaks). The rotation of each cross-section is measured as the least-squares slope d u_t/d r of
+peaks). The rotation of each cross-section is taken as the least-squares slope d u_t/d r of
 the tangential displacement across it (``section_rotation``); a hinge's rotation in the collapse
 step is the jump of that slope across +- one hinge separation. A hinge belongs to the mechanism
 if it rotates by at least ``hinge_rotation`` (default 0.2) x the largest hinge rotation; its

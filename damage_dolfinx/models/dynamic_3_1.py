@@ -11,9 +11,9 @@ inclusion (variant A), scheme (3.48)-(3.51):
 V = {v = 0 on Gamma_D}; u_0 = v_0 = 0, zeta_0 from the example. The matrix of (2) does not change
 for a fixed k: it is factorised once (prefix ``mech_``), each step assembles a right-hand
 side. Serially it is stored by 2x2 (3x3) blocks and factorised by PETSc's own LU with nested
-dissection (solvers.serial_block_lu: at n = 128, 33k dofs, solve 3.5 -> 1.8-2.1 ms and
-factorisation 430 -> 200 ms against PETSc's scalar Cholesky, itself 2x faster than MUMPS's
-solves), by MUMPS LU in parallel. The right-hand side's inertia term is M_rho/k v_{n-1}, the
+dissection (solvers.serial_block_lu: a cheaper solve and factorisation than PETSc's scalar
+Cholesky, itself faster than MUMPS's solves; benchmarks/README.md, "Why the defaults"), by
+MUMPS LU in parallel. The right-hand side's inertia term is M_rho/k v_{n-1}, the
 mass matrix assembled once (LinearSolver's rhs_product). The dimension comes
 from the mesh: on 3-D meshes with at least
 ``VELOCITY_DIRECT_MAX_DOFS_3D`` unknowns the velocity system is solved by CG + GAMG with the
@@ -51,9 +51,9 @@ from damage_dolfinx.core.parameters import ModelParameters
 
 
 #: 3-D velocity systems with at least this many unknowns: CG + GAMG instead of one factorisation.
-#: scalable.py's rule; measured (benchmarks/reference_output/contact_3d/crossover.md): for 100 steps the two break
-#: even at 6591 unknowns, the factorisation costs 55 s at 46 875 (GAMG ahead), its solves stay
-#: ~2x cheaper (long runs on mid-size meshes: -mech_ksp_type preonly -mech_pc_type lu)
+#: scalable.py's rule, measured for 100-step runs (benchmarks/reference_output/contact_3d/
+#: crossover.md): above it the factorisation's cost overtakes its cheaper solves (long runs on
+#: mid-size meshes: -mech_ksp_type preonly -mech_pc_type lu)
 VELOCITY_DIRECT_MAX_DOFS_3D = scalable.DIRECT_MAX_DOFS_3D
 
 

@@ -74,8 +74,8 @@ class DynamicTresca(Model):
         # (1) damage obstacle step (3.94), explicit source. Its reduced systems are less
         # mass-dominated than in 3.3 (k kappa / h^2 = 0.5 at n = 128, k = 0.01, kappa = 0.003;
         # 164 with kappa = 1): CG preconditioned by incomplete Cholesky (block Jacobi per rank)
-        # instead of Jacobi, unless the user chose -damage_pc_type (24 -> 6 CG
-        # iterations per step; 444 -> 83 with kappa = 1, 129 -> 54 ms per damage step)
+        # instead of Jacobi, unless the user chose -damage_pc_type (a few times fewer CG
+        # iterations and a cheaper damage step; benchmarks/README.md, "Why the defaults")
         self.damage = self.obstacle_damage_step()
         replace_default_option("damage_pc_type", "bjacobi")
         replace_default_option("damage_sub_pc_type", "icc")
@@ -138,7 +138,7 @@ class DynamicTresca(Model):
         faces = problem.builders.get("contact_faces") or {}
         return ["friction_its"] + [f"u_tau_max_{name}" for name in faces]
 
-    # -- measured tangential displacement on named contact faces (Example 2: top vs bottom)
+    # -- the tangential displacement on named contact faces (Example 2: top vs bottom)
     def _faces_setup(self, faces: dict):
         nodes = self.friction.nodes  # owned contact nodes with their unit tangents
         X = self.v.function_space.tabulate_dof_coordinates()[nodes.dofs].T

@@ -69,7 +69,8 @@ MECH_DEFAULTS = {"ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_
 #: map instead of a re-assembly (serial; equal to round-off); with Phi_L = identity the
 #: right-hand side too (FAST_RHS); CG started from the cubic extrapolation
 #: 4 v_{n-1} - 6 v_{n-2} + 4 v_{n-3} - v_{n-4} instead of v_{n-1} (same solution to rtol 1e-12;
-#: wrench, T = 0.05: 15.0 -> 9.1 iterations per step; linear 11.4, quadratic 10.1). Switches to time
+#: fewer CG iterations per step than a linear or quadratic extrapolation, benchmarks/README.md,
+#: "Why the defaults"). Switches to time
 #: or check the step both ways.
 FAST_MATRIX = True
 FAST_RHS = True

@@ -54,7 +54,8 @@ def mech_contact_amg():
     scalable.py, fails here: with the near-rigid foundation (c_nu = 1e10 against E = 100) its
     Chebyshev/Jacobi smoother gave an indefinite preconditioner once the contact term was active
     (2.3-ex1-3d, n = 10 and 20), with SOR smoothing a failed level solve at n = 20; BoomerAMG
-    took 8-14 CG iterations per Newton step at n = 10 and 20."""
+    converges in a few CG iterations per Newton step there (benchmarks/README.md, "Why the
+    defaults")."""
     return {**NEWTON, **scalable.damage_amg()} if scalable.has_hypre() else None
 
 
@@ -130,8 +131,8 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
                 A.setNearNullSpace(modes)
         else:  # 2-D and small 3-D: a factorisation kept while the Jacobian is unchanged;
             # the Jacobian is the constant K = (B eps(du), eps(w)) plus the Gamma_C term,
-            # which alone is assembled per Newton step (2.3-ex1 at n = 160, 31 ms of 99 per
-            # step), and only when its values change (the key); the residual is assembled
+            # which alone is assembled per Newton step (a large part of the step), and only
+            # when its values change (the key); the residual is assembled
             # once per step, then updated by K (x - x_0) and the Gamma_C term
             # (split_residual.py)
             split = affine_cell_split(F, self.u)  # (K, r, dr/du): F = F_cell + r

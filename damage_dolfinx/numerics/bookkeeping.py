@@ -3,17 +3,16 @@
 
 * :func:`norm_matrix`: the norm matrices of vector fields in symmetric block (SBAIJ) storage,
   one column index per d x d block of the upper triangle: the product reads about half the
-  memory of AIJ (3.1 Ex. 1 at n = 128, in the loop: 0.36 ms per product with BAIJ, about
-  0.3 with SBAIJ; the same values to rounding).
+  memory of AIJ, which counts in the loop, right after the solves (the same values to
+  rounding).
 * :func:`norm_operators`: those matrices and the integration vector of a model, assembled once.
 * :func:`extrema`: several minima and maxima of owned arrays in one Allreduce (min a = -max -a).
 * :func:`max_node_norm`: max over the nodes of |u(x_i)| from the squared components, without
-  the temporary of numpy.linalg.norm (0.19 -> 0.02 ms).
+  the temporary of numpy.linalg.norm.
 * :func:`sums_and_maxima`: sums and maxima over ranks in ONE Allreduce (an MPI operation that
   adds the first entries and takes the maximum of the others); serially no MPI call.
 * :class:`PiecewiseConstantNorm`: ||f||_L2^2 of a DG0 Function (any value shape) as w . f^2,
-  w_j = int phi_j dx assembled once: no form assembly per step (2.4 Ex. 1 at n = 128:
-  ||sigma_n||_Q 0.8 -> 0.05 ms).
+  w_j = int phi_j dx assembled once: no form assembly per step (2.4's ||sigma_n||_Q).
 * :class:`FieldNorms`: the norm operators of a model together with the owned views of its
   fields, looked up once: a history row then costs the two matrix products, three dot
   products and the extrema of zeta, and no lookup; ``carried_parts`` adds ||v||_L2 without a
@@ -31,11 +30,11 @@ from petsc4py import PETSc
 def norm_matrix(a_form, block_size: int) -> PETSc.Mat:
     """The assembled matrix of ``a_form`` (symmetric, no boundary conditions), in symmetric
     block storage (SBAIJ: the upper triangle of d x d blocks) when ``block_size`` > 1.
-    Assembled into BAIJ directly (MatConvert from AIJ takes 0.8 s at 33k dofs where the
-    assembly takes 0.01 s), then converted to SBAIJ (1 ms): the product reads about half the
-    matrix. In a run's loop, where the solves have just evicted the matrices from the caches,
-    that is what a product costs (3.1 Ex. 1 at n = 128: a history row 1.76 -> 1.64 ms, two
-    products; in isolation, with warm caches, SBAIJ is no faster)."""
+    Assembled into BAIJ directly (MatConvert from AIJ costs far more than the assembly), then
+    converted to SBAIJ (cheap): the product reads about half the matrix. In a run's loop, where
+    the solves have just evicted the matrices from the caches, that is what a product costs; in
+    isolation, with warm caches, SBAIJ is no faster (the measurements: benchmarks/README.md,
+    "Why the defaults")."""
     from damage_dolfinx import compat
     A = compat.create_matrix(a_form, "baij" if block_size > 1 else None)
     compat.assemble_matrix(A, a_form, [])
@@ -135,8 +134,7 @@ class PiecewiseConstantNorm:
         self.f = f
 
     def local(self) -> float:
-        """sum_j w_j f_j^2 over the owned dofs, in one pass (no temporary f^2: 2.4 Ex. 1 at
-        n = 128, 131k values, 0.19 -> 0.14 ms after a cache flush)."""
+        """sum_j w_j f_j^2 over the owned dofs, in one pass (no temporary f^2)."""
         values = self.f.x.array[:self.weights.size]
         return float(np.einsum("i,i,i->", self.weights, values, values))
 
@@ -231,8 +229,8 @@ class AffineStressNorm:
 
     (|T| |c + mean|^2 plus the integral of |M - mean|^2). sqrt(|T|) c_T comes from a sparse
     matrix of u's local dofs (built once: the P1 gradients of each cell times B), S_T from
-    d + 1 vector sums over M's cell blocks, q from one product: 2.3 Ex. 1 at n = 128, 1.8 ms
-    of form assembly -> about 0.9 ms. Equal to the assembled form to round-off
+    d + 1 vector sums over M's cell blocks, q from one product: about half the cost of the form's
+    assembly (benchmarks/README.md, "Why the defaults"). Equal to the assembled form to round-off
     (tests/test_memory_contact_2_3.py). ``local()`` is this rank's part over its owned cells
     (add over ranks). :meth:`applies` says whether the spaces fit (P1 u, DG1 M with d + 1
     dofs per cell, simplices with a P1 geometry)."""
@@ -309,7 +307,7 @@ class AffineStressNorm:
         S *= self.mean_scale                             # sqrt|T| S / (d + 1)
         S = S.ravel()
         t = np.add(S, self.c, out=self.c)                # sqrt|T| (c + mean m)
-        # einsum, not np.dot: the reference BLAS's ddot is 2x slower here
+        # einsum, not np.dot: the reference BLAS's ddot is slower here
         mean_part = float(np.einsum("i,i->", t, t))
         spread = float(np.multiply(np.multiply(m, m, out=self._buf), self.q_weight,
                                    out=self._buf).sum())

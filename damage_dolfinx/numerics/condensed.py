@@ -5,7 +5,7 @@ The friction Jacobians of friction/ have this form: A is the constant matrix of 
 (or increment) step and K sits on the tangential dofs of the contact nodes (nodal quadrature,
 axis-parallel tangents). K changes whenever the stick set or the multipliers change, which in a
 stick-slip phase is every Newton or active-set iteration; a new Cholesky factorisation of J each
-time cost 130-200 ms at 33k dofs (3.2-ex1, n = 128), against 5-7 ms for a triangular solve.
+time costs many triangular solves (benchmarks/README.md, "Why the defaults").
 
 :class:`DiagonalUpdateSolver` therefore splits the unknowns into C and the rest I and uses the
 exact static condensation
@@ -17,7 +17,7 @@ with A_II factorised once per run and the Schur complement S = A_CC - A_CI A_II^
 (|C| x |C|, dense, replicated on every rank) computed once: a new K costs one dense Cholesky of
 S + D (|C| is about the number of contact nodes, ~130 at 33k dofs), a solve two triangular
 solves with A_II. When the same K is used by REFACTOR_AFTER consecutive solves (a steady
-stick set: one or two Newton iterations per step), J itself is factorised once and used while K
+stick set: few Newton iterations per step), J itself is factorised once and used while K
 stays (one triangular solve per solve, as before). Both paths are exact direct solves; they
 differ by round-off. The condensation is built lazily, at the first solve with a K other than
 the factorised one.
@@ -67,7 +67,7 @@ class DiagonalUpdateSolver:
         self.condense = PETSc.Options().getBool(prefix + "condense", True)
         self.full_factorizations = self.condensed_factorizations = 0
         self.full_solves = self.condensed_solves = 0
-        # the dense Cholesky of S + D: imported here, at set-up (35-50 ms), not inside a step's
+        # the dense Cholesky of S + D: imported here, at set-up, not inside a step's
         # timing, and only by the runs that build this solver
         import scipy.linalg
         self._linalg = scipy.linalg
@@ -128,7 +128,7 @@ class DiagonalUpdateSolver:
         return S
 
     def _schur_block(self):
-        """S by one MatMatSolve with all columns of A_IC (MUMPS on several ranks: 3x faster
+        """S by one MatMatSolve with all columns of A_IC (MUMPS on several ranks: faster
         than column by column), gathered on every rank."""
         B = self.A_IC.convert("dense")
         X = B.duplicate()

@@ -57,7 +57,7 @@ def near_contact(form, V, facet_tags):
     """``form`` (UFL, linear in a test function of V) with its cell integrals restricted to the
     owned cells that have a node on Gamma_C: the same entries at every node of Gamma_C (each
     gathers the cells around it; only the order of the sums changes), an assembly over a strip
-    of cells instead of the whole mesh (2.2 Ex. 1 at n = 128: 3.5 -> 0.3 ms). Facet integrals
+    of cells instead of the whole mesh (a fraction of the cost). Facet integrals
     are kept as they are. ``form`` unchanged where a cell integral already has a subdomain."""
     cells = [itg for itg in form.integrals() if itg.integral_type() == "cell"]
     if not cells or any(itg.subdomain_id() not in ("everywhere", "otherwise")
@@ -197,8 +197,8 @@ class ContactOutput:
         residual's ``rhs_taps``): the reaction R = A v - l at the contact nodes from the rows of
         A there (the matrix of ``a`` without boundary conditions, assembled once) and the
         entries of l there, copied as the solver assembles l. The same numbers as the residual
-        assembled over the strip of cells (sums in another order), without an assembly per row
-        (2.2, 2.4, 3.2 Ex. 1 at n = 128: 0.3-0.4 ms in the loop). Used for the step whose l was
+        assembled over the strip of cells (sums in another order), without an assembly per row.
+        Used for the step whose l was
         tapped (``stepper.n``); any other step, and on several ranks, assembles."""
         residual = getattr(getattr(stepper, "friction", None), "residual", None)
         taps = getattr(residual, "rhs_taps", None)

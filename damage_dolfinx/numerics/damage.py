@@ -52,8 +52,8 @@ def fast_path_counts(stepper) -> dict:
 
 #: SNES defaults of the obstacle step; override with -damage_snes_* options.
 #: The reduced systems (inactive set) are mass-dominated, M + k kappa K: CG + Jacobi to rtol 1e-12
-#: solves them in a few iterations without a factorisation per Newton step (measured on 2.2 Ex. 1,
-#: n = 64, k = 0.002: damage steps 6.3 s with MUMPS LU, 0.9 s with CG + Jacobi, same fields).
+#: solves them in a few iterations without a factorisation per Newton step, several times
+#: faster than MUMPS LU with the same fields (benchmarks/README.md, "Why the defaults").
 OBSTACLE_DEFAULTS = {"snes_type": "vinewtonrsls", "snes_rtol": 1e-10, "snes_atol": 1e-12,
                      "snes_stol": 0.0, "snes_max_it": 50, "snes_linesearch_type": "basic",
                      "ksp_type": "cg", "pc_type": "jacobi", "ksp_rtol": 1e-12, "ksp_atol": 1e-50,
@@ -119,7 +119,7 @@ class DamageStep:
     def _converged(self, snes, it, norms):
         """PETSc's default tests plus a step test for the VI: when many nodes sit within
         round-off of a bound (3.3, lam_D = 0), the active set settles a few nodes per iteration
-        while the steps are already tiny (measured 4e-9 for ||z|| = 257 at n = 256): stop when
+        while the steps are already tiny (seen: 4e-9 for ||z|| = 257 at n = 256): stop when
         ||dz|| <= OBSTACLE_STEP_RTOL ||z||."""
         xnorm, ynorm, fnorm = norms
         rtol, atol, _, max_it = snes.getTolerances()

@@ -105,7 +105,7 @@ class CellwiseIntegrand:
         c = self.comps
         S = compat.eval_expression(self.expr, self.mesh, self.cells).reshape(-1, c)
         z = np.take(self.zeta.x.array, self._zc, out=self._z)  # (cells, d + 1)
-        # g[cell, vertex, :] = z[cell, vertex] S[cell, :] (einsum: 2.4x the broadcast product)
+        # g[cell, vertex, :] = z[cell, vertex] S[cell, :] (einsum: faster than broadcasting)
         values = g.x.array.reshape(-1, c)
         if self._gc is None:
             np.einsum("ij,ik->ijk", z, S, out=values[:z.size].reshape(z.shape + (c,)))

@@ -12,12 +12,12 @@ k kappa K constant for a run (damage.py). PETSc's ``vinewtonrsls`` started from 
 3. stops if the norm of F1 = B z1 - l over the inactive set of (z1, F1) is <= atol or <= rtol
    times that of step 1, and iterates otherwise.
 
-Each SNES iteration extracts B_II, sets up its preconditioner and runs CG (9-21 iterations on the
-wrench). :class:`ObstacleFastPath` does steps 1-3 itself: the same active set from the same
-(z0, F0), so nodes within round-off of a bound are treated exactly as the SNES treats them (a
-value within 1e-8 of a bound is held where it is if F pushes it outward, and moves freely
-otherwise; this also covers the wrench, lam_D = 0, where zeta stays within round-off of 1 for
-a while). Its linear algebra is cached:
+Each SNES iteration extracts B_II, sets up its preconditioner and runs CG.
+:class:`ObstacleFastPath` does steps 1-3 itself: the same active set from the same (z0, F0), so
+nodes within round-off of a bound are treated exactly as the SNES treats them (a value within
+1e-8 of a bound is held where it is if F pushes it outward, and moves freely otherwise; this
+also covers the wrench, lam_D = 0, where zeta stays within round-off of 1 for a while). Its
+linear algebra is cached:
 
 * empty active set (most steps of every problem; the wrench never reaches zeta_star): B itself,
   factorised once per run (Cholesky: PETSc's, nested dissection, serially; MUMPS's on several
@@ -55,11 +55,10 @@ VI_BOUND_WINDOW = 1e-8
 #: step goes to the SNES
 FEASIBILITY_TOL = 1e-10
 #: largest size (by dimension) whose full matrix B is factorised (Cholesky: PETSc's serially,
-#: MUMPS's on several ranks): at 65k dofs in 2-D the factorisation (nested dissection) takes
-#: 0.6 s once and a solve 4 ms, against 10-20 ms for the CG the SNES runs. The CG's iterations
-#: grow with the mesh (B = M + k kappa K: its condition grows like 1/h^2), so its cost per step
-#: grows like N^1.5: 3.1-ex1, 32 steps, serially, at 321 489 scalar dofs 1.14 s a step with CG
-#: against 0.14 s at 160 801 with the factorisation. In 2-D the bound is the damage space of a
+#: MUMPS's on several ranks): a solve with the factor (nested dissection, made once) costs a
+#: fraction of the CG the SNES runs. The CG's iterations grow with the mesh
+#: (B = M + k kappa K: its condition grows like 1/h^2), so its cost per step grows like N^1.5
+#: (measured: benchmarks/README.md, "Why the defaults"). In 2-D the bound is the damage space of a
 #: mesh whose vector space reaches the rule's AMG_MIN_DOFS[2] (2e6, numerics/scalable.py), whose
 #: factorisations are kept to that size; 3-D factors fill faster
 CHOLESKY_MAX_DOFS = {2: 1_000_000, 3: 30_000}
@@ -68,7 +67,7 @@ CHOLESKY_MAX_DOFS = {2: 1_000_000, 3: 30_000}
 #: SNES's CG for all (each accepted step then equals the SNES's bit for bit)
 SOLVERS = ("auto", "cholesky", "cg")
 #: after failed attempts on a nonempty active set in a row (3.1-ex1 while its zeta* region grows:
-#: the SNES needs 2-3 iterations in most steps), such attempts pause 1, 2, 4, ... up to this
+#: the SNES needs a few iterations in most steps), such attempts pause 1, 2, 4, ... up to this
 #: many steps. Failed attempts on an empty set (3.3-ex2: values overshoot 1 every step) cost one
 #: pair of triangular solves and never pause.
 #: Only attempts whose hit equals the SNES's answer bit for bit (its CG) pause, so the pause
@@ -247,7 +246,7 @@ class ObstacleFastPath:
     def _ksp(self, A, direct: bool) -> PETSc.KSP:
         ksp = PETSc.KSP().create(self.B.getComm())
         ksp.setOperators(A)
-        if direct:  # nested dissection: 4 against 26 ms per solve at 65k dofs (natural order)
+        if direct:  # nested dissection: several times faster solves than the natural order
             ksp.setType("preonly")
             pc = ksp.getPC()
             pc.setType("cholesky")

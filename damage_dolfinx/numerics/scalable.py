@@ -27,10 +27,9 @@ from petsc4py import PETSc
 
 #: the smallest system (global unknowns of its function space) solved by CG + AMG, by
 #: dimension of the mesh; smaller systems are factorised (docs/solvers.md: how they were chosen)
-#: 2-D: measured (docs/solvers.md) at 1e6 unknowns, 2.1-ex1 elasticity, serially: PETSc Cholesky
-#: 59 s once + 0.155 s a solve against GAMG 2.8 s + 3.96 s a solve (35 CG its, rtol 1e-10): a
-#: 100-step run is 3x cheaper direct; AMG wins only below ~17 steps. The factorisation (time
-#: ~N^1.6, 3.7 GB at 1e6) decides above: 2e6.
+#: 2-D: at 1e6 unknowns a factorised run is cheaper than CG + GAMG unless it is very short
+#: (measured: docs/solvers.md, "Why 2 000 000 in 2-D"); the factorisation's time and memory,
+#: which grow faster than N, decide above: 2e6.
 AMG_MIN_DOFS = {2: 2_000_000, 3: 3000}
 #: the 3-D threshold under its former name
 DIRECT_MAX_DOFS_3D = AMG_MIN_DOFS[3]

@@ -86,8 +86,8 @@ DIRECT = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "
 
 def spd_direct(comm) -> dict:
     """Direct solve of a symmetric positive (semi)definite matrix: Cholesky, by PETSc's own
-    factorisation in serial (its triangular solves are 2.5-3x faster than MUMPS's here: 9 vs
-    28 ms at 33k dofs, 62 vs 161 ms at 132k, benchmarks/README.md) and by MUMPS in parallel."""
+    factorisation in serial (its triangular solves are faster than MUMPS's at these sizes;
+    benchmarks/README.md, "Why the defaults") and by MUMPS in parallel."""
     package = "petsc" if comm.size == 1 else "mumps"
     return {"ksp_type": "preonly", "pc_type": "cholesky", "pc_factor_mat_solver_type": package}
 
@@ -101,9 +101,9 @@ LAGGED_DIRECT = {"ksp_type": "cg", "ksp_rtol": 1e-12, "ksp_atol": 1e-50, "ksp_ma
 
 def serial_cholesky(comm, options: dict) -> dict:
     """``options`` (a factorisation by MUMPS LU) with PETSc's own Cholesky serially, for SPD
-    matrices: its triangular solves are 2-3x faster than MUMPS's (spd_direct). Unchanged in
-    parallel. Measured at the convergence references, serially: 2.1-ex1 at n = 160
-    91 -> 47 ms per step, 2.3-ex1 at n = 256 306 -> 181 ms."""
+    matrices: its triangular solves are faster than MUMPS's (spd_direct), which shortens the
+    steps of the convergence references. Unchanged in parallel (the measurement:
+    benchmarks/README.md, "Why the defaults")."""
     if comm.size > 1:
         return dict(options)
     return {**options, "pc_type": "cholesky", "pc_factor_mat_solver_type": "petsc"}
@@ -113,8 +113,8 @@ def serial_block_lu(comm, options: dict) -> dict:
     """``options`` (a factorisation by MUMPS LU) with PETSc's own LU (nested dissection)
     serially, for a LinearSolver with ``block_matrix=True`` on a vector space: the matrix is
     then stored by bs x bs blocks (BAIJ) and the triangular solves work on blocks. Unchanged in
-    parallel. Measured on 3.1-ex1's velocity matrix at n = 128 (33282 unknowns, bs = 2), against
-    the scalar Cholesky of serial_cholesky: solve 3.5 -> 1.7 ms, factorisation 430 -> 250 ms."""
+    parallel. On 3.1-ex1's velocity matrix both its solve and its factorisation are cheaper than
+    the scalar Cholesky of serial_cholesky (benchmarks/README.md, "Why the defaults")."""
     if comm.size > 1:
         return dict(options)
     return {**options, "pc_type": "lu", "pc_factor_mat_solver_type": "petsc"}

@@ -23,7 +23,7 @@ scheme is stable iff
   of K x = g (4 M + 2 k C) x. k^2 g(k) increases with k; its root lies between 2/omega and the
   closed form above, and is found by false position in log k (:func:`k_max_nonproportional`,
   4-6 eigensolves). For 3.1 Ex. 1 this gives k_max = 0.0129-0.0146 (n = 128 ... 4) where the
-  closed form says 0.2; measured onsets of chatter lie within 4% above it.
+  closed form says 0.2; the onsets of chatter seen in runs lie within 4 % above it.
 
 Cheap first (:func:`estimate_stability`): a lower bound of k_max with no eigensolve
 (stability_bound.py); the eigenvalues below only when the time step is above it.
@@ -55,8 +55,8 @@ SAFETY = 0.8
 PREFIX = "stability_"
 
 #: residual tolerance of the eigensolves inside estimate_stability: the eigenvalue error is of
-#: the order of the squared residual, k_max ~ omega^-1; measured on 3.1 Ex. 1, n = 128: omega^2
-#: within 4e-5 and k_max within 1e-9 of the 1e-4 results, 25% faster
+#: the order of the squared residual, k_max ~ omega^-1; on 3.1 Ex. 1 it gives the k_max of a
+#: tolerance of 1e-4 to 1e-9, in less time (benchmarks/README.md, "Why the defaults")
 EIG_TOL = 1e-3
 
 

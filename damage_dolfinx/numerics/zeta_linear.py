@@ -91,7 +91,7 @@ class ZetaLinearMatrix:
                                shape=(self.data0.size, nq))
         self.colours = int(ncol)
         # per step: zbar = C zeta, then W = P zbar as P^T's transpose product (a loop over the
-        # cells, 36 values each: 2x faster than the CSR product by rows of ~2 values), into
+        # cells, 36 values each: faster than the CSR product by rows of ~2 values), into
         # one of two buffers: the last update's W(zeta_n) and the one before, W(zeta_{n-1}),
         # which the right-hand side of the next step needs (product())
         self._C = _petsc_csr(self.C, A.getComm())

@@ -9,7 +9,7 @@ came from.
 Readings (``--reading literal|evidence``): ``literal`` is exactly the stated thesis
 data (the catalogue entry itself); ``evidence`` replaces some of it by the values that reproduce
 the thesis results with the fewest departures from the text (:class:`Reading`, each departure an
-assumption with its thesis lines and the measured evidence). An example without an evidence
+assumption with its thesis lines and the evidence of runs). An example without an evidence
 reading has evidence = literal. ``Example.default_reading`` says which one runs by default.
 """
 from __future__ import annotations
@@ -49,7 +49,7 @@ def in_words(assumption: str) -> str:
 @dataclass
 class Reading:
     """Departures of one reading from the stated data: parameter values, loads, and the
-    assumptions (thesis lines, measured evidence) that justify them."""
+    assumptions (thesis lines, the evidence of runs) that justify them."""
     overrides: dict = field(default_factory=dict)
     traction: Optional[Callable] = None
     body_force: Optional[Callable] = None
@@ -64,7 +64,7 @@ class Example(Problem):
     (a warning above k_max); a k you choose above k_max is refused."""
     title: str = ""
     section: str = ""
-    diameter: float = math.nan       # the body's diameter (nan: measured on the mesh)
+    diameter: float = math.nan       # the body's diameter (nan: taken from the mesh)
     h: Optional[float] = None        # gmsh meshes: element size
     dim: int = 2                     # space dimension of the mesh (3: the 3-D examples)
     assumptions: list = field(default_factory=list)

@@ -122,7 +122,7 @@ class Problem:
     dim = 0                 # the space dimension, known once the mesh is built
     h = None                # the element size of a gmsh mesh family (catalogue)
     mesh_file = None        # a gmsh file replacing the mesh of a catalogue example (--mesh)
-    diameter = math.nan     # the body's diameter (nan: measured on the mesh)
+    diameter = math.nan     # the body's diameter (nan: taken from the mesh)
     convergence = None      # a default convergence study
     readings = {}           # readings beyond the literal data (none)
     reading = "literal"

@@ -2,13 +2,9 @@
 
 The estimate scales the vertex count of the example's default mesh (built once on one rank, only
 when the requested mesh is more than 4x finer) quadratically with n / n_default or h_default / h,
-and charges per vertex what the heaviest 2-D runs measured (peak RSS, serial, thesis
-factorisations included; ``/usr/bin/time -f %M``):
-
-    2.1-ex1  n =  80 ->  160 (6 336 -> 24 960 vertices):   187 ->  294 MB   5.8 kB / vertex
-    2.3-ex1  n = 128 ->  256 (16 641 -> 66 049 vertices):  267 ->  641 MB   7.6 kB / vertex
-
-so BYTES_PER_VERTEX = 10 kB (direct factorisations fill in slightly faster than linearly) plus
+and charges per vertex a little more than the heaviest 2-D runs took (peak RSS, serial, thesis
+factorisations included; the figures: benchmarks/README.md, "Why the defaults"): so
+BYTES_PER_VERTEX = 10 kB (direct factorisations fill in slightly faster than linearly) plus
 BASE_BYTES = 200 MB per rank (Python, PETSc, the JIT). The total is compared with the available
 memory (MemAvailable of /proc/meminfo) summed over the distinct hosts of the MPI job.
 """
@@ -36,8 +32,8 @@ def available_bytes():
 
 def _scale(ex, n, h) -> float:
     """(requested vertices) / (default vertices), from the mesh-size ratio to the power of the
-    dimension (2, or 3 for 3-D examples: there BYTES_PER_VERTEX also holds, measured 4.5-8.3 kB
-    per vertex above BASE_BYTES for 2.1-ex1-3d with its AMG solvers, n = 20-30)."""
+    dimension (2, or 3 for 3-D examples: there BYTES_PER_VERTEX also holds, for 2.1-ex1-3d with
+    its AMG solvers)."""
     dim = getattr(ex, "dim", 2)
     if n is not None and ex.n:
         return (n / ex.n) ** dim

@@ -2,7 +2,7 @@
 
 The reference run and all coarse runs advance in lockstep: whenever the reference reaches a
 coarse run's next time level, that run takes its step, is transferred exactly to the nested
-reference mesh (:func:`post.nested_transfer`, P1 or DG0) and its error is measured there,
+reference mesh (:func:`post.nested_transfer`, P1 or DG0) and its error is computed there,
 
     e(n, k) = max over common time levels of the sum of the stepper's ``error_components``
               (default ||u_ref - u_hk||_V + ||zeta_ref - zeta_hk||_Y; each problem sets the
@@ -243,7 +243,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
 
     components = comm.bcast([(name, None, norm) for name, _, norm in ref.error_components]
                             if comm.rank == 0 else None, root=0)
-    if ref_serial:  # the errors were measured on rank 0
+    if ref_serial:  # the errors were computed on rank 0
         errors = comm.bcast([(r.err, r.err_T, r.err_parts) for r in runs]
                             if comm.rank == 0 else None, root=0)
         for r, (err, err_T, parts) in zip(runs, errors):

@@ -1,10 +1,10 @@
-"""The cells of a convergence study and how their errors are measured against the reference
+"""The cells of a convergence study and how their errors are computed against the reference
 (convergence.py runs them in lockstep).
 
 A coarse cell (n, k) runs on all ranks of the study (large cells) or serially on one rank
 (``_owners``: shared out by cost per time level); at each of its time levels its error
 components are transferred to the reference mesh (exactly, ``post.nested_transfer``, when the
-family is nested; by point evaluation, point_transfer.py, otherwise) and measured there,
+family is nested; by point evaluation, point_transfer.py, otherwise) and computed there,
 
     e(n, k) = max over common time levels of sum_c ||c_ref - c_hk||_c,
 

@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 #: zlib level of the PNG files: 1 writes a field figure in a few ms (the default 6 takes
-#: several times longer); the pixels are the same, the files up to a third larger (the field
-#: figure of 3.1-ex1 at n = 128: 151 -> 195 kB; its setting figure: 338 -> 326 kB)
+#: several times longer); the pixels are the same, the files up to a third larger
+#: (benchmarks/README.md, "Why the defaults")
 PNG_COMPRESS_LEVEL = 1
 
 
@@ -59,7 +59,7 @@ def inside_test(cells):
 
 def tight_bbox(fig, pad_inches):
     """The bounding box that ``savefig(bbox_inches="tight")`` would compute (all the figure's
-    artists, padded by ``pad_inches``: rcParams["savefig.pad_inches"]), measured on the
+    artists, padded by ``pad_inches``: rcParams["savefig.pad_inches"]), computed on the
     laid-out figure: handed to savefig as ``bbox_inches``, it spares savefig a draw pass of its
     own to find it."""
     return fig.get_tightbbox(fig.canvas.get_renderer()).padded(pad_inches)

@@ -70,7 +70,7 @@ def boundary_edges(xy):
     a, b = np.round(edges[:, 0], 9), np.round(edges[:, 1], 9)
     swap = ((a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1])))[:, None]
     key = np.hstack([np.where(swap, b, a), np.where(swap, a, b)])
-    # one lexsort of the four coordinates (np.unique(axis=0) sorts rows as objects: 8x slower)
+    # one lexsort of the four coordinates (np.unique(axis=0) sorts rows as objects: slower)
     order = np.lexsort(key.T[::-1])
     ks = key[order]
     new = np.ones(len(ks) + 1, dtype=bool)

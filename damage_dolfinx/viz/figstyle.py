@@ -53,7 +53,7 @@ def plt():
     import matplotlib.pyplot as pyplot
     pyplot.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
                             "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False,
-                            "figure.dpi": DPI})  # laid out as saved: text extents measured once
+                            "figure.dpi": DPI})  # laid out as saved: text extents computed once
     return pyplot
 
 

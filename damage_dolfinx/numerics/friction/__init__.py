@@ -79,13 +79,12 @@ def register_solver(name: str, factory, needs_clamp: bool = False):
     if needs_clamp:
         _NEEDS_CLAMP.add(name)
 
-#: Uzawa step (the thesis gives none) from log-spaced sweeps: at n = 16, k = 0.01 (all nodes slip)
-#: rho = 1, 10, 100 give 2 iterations per step (Newton solution to 2e-14), rho = 0.01 needs 25; at
-#: k = 0.02 (stick-slip) rho = 10 oscillates (no convergence), rho = 1 needs 17-31 and rho = 0.1
-#: 87-135 per step
+#: Uzawa step (the thesis gives none) from log-spaced sweeps at n = 16, k = 0.01 (all nodes slip)
+#: and k = 0.02 (stick-slip): the largest rho that converges in both (the iteration counts:
+#: benchmarks/README.md, "Why the defaults")
 RHO_UZAWA = 1.0
-#: Bermudez-Moreno omega from the same sweep: omega = 100, 300, 1000 give 50, 31, 86 iterations
-#: per step and 4.6e-7, 2.5e-6, 1.0e-5 relative V-distance to Newton at tol 1e-6
+#: Bermudez-Moreno omega from the same sweep: the one closest to Newton's solution at tol 1e-6
+#: at a moderate iteration count (benchmarks/README.md, "Why the defaults")
 OMEGA_PD = 100.0
 
 #: the friction data every friction model's defaults hold (``params.extra``)

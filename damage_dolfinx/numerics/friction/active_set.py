@@ -30,7 +30,8 @@ class PrimalDualActiveSet:
     |v_tau| <= eps, K_i = m_i g_i (1 - lambda_i sgn v_tau,i)/|v_tau,i| on the others (0 once
     lambda_i is consistent, large while it points against the slip). A slip reversal is thus
     damped by the multiplier, where the primal Newton (K_i = 0 on slipping nodes) overshoots and
-    its line search needs 10-100 iterations per step (2.2-ex1 at k = 0.02, benchmarks/README.md).
+    its line search needs many iterations per step (2.2-ex1 at k = 0.02; benchmarks/README.md,
+    "Why the defaults").
     The stopping test is the primal Newton's: ||F(v)|| of :class:`AlgebraicResidual`.
     Needs axis-parallel tangents (tau tau^T diagonal), like the bilateral contact conditions.
 
@@ -39,8 +40,8 @@ class PrimalDualActiveSet:
     m g (I - lambda n^T)/|s| (n = s/|s|), not symmetric unless lambda is parallel to n, and the
     multiplier update lambda <- P(lambda + (I - lambda n^T) s_new/|s|) (its fixed point with
     s_new = s is lambda = n). Its symmetric part would keep Cholesky usable but makes the
-    multiplier converge linearly (factor 1/2: 35 iterations on the sliding block of
-    tests/test_tresca_3d.py against 8 with the exact block), so J = A + blocks is assembled and
+    multiplier converge linearly (factor 1/2: several times the iterations of the exact block on
+    the sliding block of tests/test_tresca_3d.py), so J = A + blocks is assembled and
     solved by GMRES preconditioned with the LU factorisation of an earlier J
     (condensed.BlockUpdateSolver with lag_its)."""
 

@@ -28,7 +28,7 @@ REFACTOR_ITS = 10
 #: 3-D: the Newton systems J = A + blocks are solved by CG preconditioned with the Cholesky
 #: factorisation of an earlier J, rebuilt when the stick set changes or CG needed more than this
 #: many iterations (a sliding node's block changes in every iteration; a factorisation of a 3-D
-#: J costs 0.5-2 s at 6591 unknowns, a CG iteration a triangular solve)
+#: J costs as much as many CG iterations, each a triangular solve)
 LAG_MAX_ITS_3D = 30
 
 #: the first attempt of each step: full Newton steps (no energy evaluations), at most this many

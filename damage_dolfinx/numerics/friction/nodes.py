@@ -157,8 +157,8 @@ def linear_defaults(V, symmetric=True) -> dict:
     """KSP defaults of the friction solves on V: direct (Cholesky; LU for a non-symmetric
     matrix) in 2-D and 3-D. Not the AMG of scalable.py: the stick blocks m g/eps (eps = 1e-9)
     make the Jacobian ~1e9 times stiffer on the contact dofs than elsewhere, and CG + GAMG
-    (rtol 1e-10) did not give usable Newton directions: 2.2-ex1-3d at n = 16 (14 739 unknowns)
-    stopped at step 10 after 100 Newton iterations, where Cholesky converges (5 per step).
+    (rtol 1e-10) did not give usable Newton directions: on 2.2-ex1-3d at n = 16 its Newton
+    stopped at the iteration limit, where Cholesky converges in a few iterations per step.
     ``-friction_ksp_type cg -friction_pc_type gamg`` etc. still select it (with the rigid-body
     modes of ``near_nullspace``)."""
     return spd_direct(V.mesh.comm) if symmetric else lu_direct(V.mesh.comm)
