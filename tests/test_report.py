@@ -181,7 +181,8 @@ def test_planted_departure_reaches_the_figure_verdict(tmp_path):
     from reproduction.figures import ThesisFigure
     cells = _square()
     strong = _panel(tmp_path, "strong", cells, 0.2 + 0.8 * cells[..., 1])
-    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"))
+    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
+                      subject=("stress", "damage"))
     fitted = {"what": "kappa = 0.003 instead of kappa = 1", "basis": "fitted", "fitted": True,
               "against_text": False, "source": "reading", "text": "..."}
     context = dict(run_context(_run_folder(tmp_path, "run", departures=[fitted])), T_full=1.0)
@@ -201,7 +202,8 @@ def test_planted_early_stop_is_not_comparable(tmp_path):
     from reproduction.figures import ThesisFigure
     cells = _square()
     strong = _panel(tmp_path, "strong", cells, 0.2 + 0.8 * cells[..., 1])
-    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"))
+    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
+                      subject=("stress", "damage"))
     stopped = dict(run_context(_run_folder(tmp_path, "stop", "zeta_star_reached", 0.4)),
                    T_full=1.0)
     verdict = judge(fig, [strong], context=stopped)[0]
@@ -209,31 +211,105 @@ def test_planted_early_stop_is_not_comparable(tmp_path):
     cut = dict(run_context(_run_folder(tmp_path, "cut")), T_full=1.0, T_run=0.5)
     assert category(judge(fig, [strong], context=cut)[0]) == "not comparable"
     event = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
-                         event="collapse")
+                         event="collapse", subject=("stress", "damage"))
     collapse = dict(run_context(_run_folder(tmp_path, "collapse", "collapse", 0.02)), T_full=0.3)
     assert category(judge(event, [strong], context=collapse)[0]) == "reproduced"
 
 
 def test_planted_differs_whose_feature_holds(tmp_path):
-    """Figure 2.12's statement (top edge clamped, bottom edge moves) holding in the data is not
-    'differs', however large the drawn displacement; a failed check quotes our number."""
+    """Figure 2.12's statement (top edge clamped, bottom edge moves) is about the configuration
+    the thesis draws x3: a slide of a fraction of the body holds; a 16 m slide of a 4 m square
+    (x3: twelve times the body) is not that configuration and differs, quoting our numbers; a
+    moving top differs too."""
     import numpy as np
     from reproduction.checks import judge
     from reproduction.classes import category
     from reproduction.figures import THESIS_FIGURES
     fig = next(f for f in THESIS_FIGURES if f.number == "2.12")
     cells = 4 * _square()
-    disp = np.zeros_like(cells)
-    disp[..., 0] = 16.0 * (1 - cells[..., 1] / 4)             # bottom slides 16 m, top fixed
-    npz = _panel(tmp_path, "slide", cells, np.ones(cells.shape[:2]), disp=disp, amplification=3.0)
     context = {"T_full": 5.0, "status": "completed", "t_final": 5.0, "departures": []}
-    verdict = judge(fig, [npz], context=context)[0]
-    assert category(verdict) == "reproduced", verdict
-    assert "top edge 0.00, bottom edge 1.00 of max |u|" in verdict
-    disp[..., 0] = 16.0 * cells[..., 1] / 4                   # the top moves: the statement fails
+    disp = np.zeros_like(cells)
+    for slide, expected in ((0.16, "reproduced"), (16.0, "differs")):
+        disp[..., 0] = slide * (1 - cells[..., 1] / 4)      # bottom slides, top fixed
+        npz = _panel(tmp_path, f"slide{slide}", cells, np.ones(cells.shape[:2]), disp=disp,
+                     amplification=3.0)
+        verdict = judge(fig, [npz], context=context)[0]
+        assert category(verdict) == expected, verdict
+        if expected == "reproduced":
+            assert "top edge 0.00, bottom edge 1.00 of max |u|" in verdict
+    assert "x3 (the thesis's factor) gives 8.5 times its size" in verdict
+    disp[..., 0] = 0.16 * cells[..., 1] / 4                  # the top moves: the statement fails
     npz = _panel(tmp_path, "top", cells, np.ones(cells.shape[:2]), disp=disp, amplification=3.0)
     verdict = judge(fig, [npz], context=context)[0]
     assert category(verdict) == "differs" and "top edge 1.00, bottom edge 0.00" in verdict
+
+
+def test_planted_vacuous_premises_fail(tmp_path):
+    """A check counts only when its premise holds. No penetration without contact (Figure
+    3.4's beam off its foundation) fails with that reason; a damage pattern inside a body at
+    zeta* nearly everywhere (a runaway) fails with that reason; with the premise holding the
+    same data pass."""
+    import numpy as np
+    from reproduction.checks import judge, run_context
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES, ThesisFigure
+    cells = _square()
+    fig_3_4 = next(f for f in THESIS_FIGURES if f.number == "3.4")
+    npz = _panel(tmp_path, "beam", cells, np.ones(cells.shape[:2]),
+                 disp=0.01 * np.ones_like(cells), amplification=4.0)
+    for length, expected in ((0.0, "differs"), (0.4, "reproduced")):
+        folder = _run_folder(tmp_path, f"beam{length}")
+        (folder / "history.csv").write_text(
+            "step,t,u_L2,penetration_rms,contact_length\n0,0,0,0,0.5\n1,1,0.2,0,%g\n" % length)
+        context = dict(run_context(folder), T_full=1.0)
+        verdict = judge(fig_3_4, [npz], context=context)[0]
+        assert category(verdict) == expected, verdict
+    assert "premise fails: no contact at the final time" not in verdict
+    folder = _run_folder(tmp_path, "beam_off")
+    (folder / "history.csv").write_text("step,t,u_L2,penetration_rms,contact_length\n"
+                                        "0,0,0,0,0.5\n1,1,0.2,0,0\n")
+    verdict = judge(fig_3_4, [npz], context=dict(run_context(folder), T_full=1.0))[0]
+    assert "premise fails: no contact at the final time" in verdict, verdict
+    colocated = ThesisFigure("9.9", "x", "", ("a.png",), ("colocated",),
+                             subject=("stress", "damage"))
+    pattern = 0.2 + 0.8 * cells[..., 1]                     # ranks with the stress
+    assert category(judge(colocated, [_panel(tmp_path, "pattern", cells, pattern)])[0]) == \
+        "reproduced"
+    runaway = 0.01 + 0.01 * cells[..., 1]                   # at zeta* everywhere, same ranks
+    verdict = judge(colocated, [_panel(tmp_path, "runaway", cells, runaway)])[0]
+    assert category(verdict) == "differs" and "premise fails" in verdict, verdict
+    assert "a pattern inside a fully damaged body proves nothing" in verdict
+
+
+def test_statement_subjects_rule_the_checks(tmp_path):
+    """A statement about the configuration is not judged by the damage's one-colour rule
+    (Figure 2.21 with a faint damage field is reproduced, not 'not visible'); a check of another
+    subject than the statement's is refused; a 'nothing to test' beside a quoted statement is
+    refused; every quoted statement of the catalogue of figures is tested."""
+    import numpy as np
+    from reproduction.checks import judge
+    from reproduction.classes import Evidence, category, classify
+    from reproduction.figures import THESIS_FIGURES, ThesisFigure, validate
+    cells = _square()
+    fig_2_21 = next(f for f in THESIS_FIGURES if f.number == "2.21")
+    faint = _panel(tmp_path, "faint", cells, 0.95 + 0.04 * cells[..., 1],
+                   disp=0.01 * np.ones_like(cells))
+    context = {"u_L2_first": 0.0, "u_L2_last": 0.5, "u_L2_max": 1.0}
+    verdict = judge(fig_2_21, [faint], context=context)[0]
+    assert category(verdict) == "reproduced", verdict
+    wrong = ThesisFigure("9.9", "x", "", ("a.png",), ("displaced", "colocated"),
+                         quote="the configuration is not the stress-free one",
+                         subject=("configuration",))
+    with pytest.raises(ValueError, match="colocated"):
+        judge(wrong, [faint], context=context)
+    quoted = ThesisFigure("9.9", "x", "", ("a.png",), (), quote="the highest stress is central")
+    with pytest.raises(ValueError, match="quotes a statement"):
+        validate(quoted)
+    with pytest.raises(ValueError, match="refused"):
+        classify(Evidence(statement=False, quote="the highest stress is central"))
+    for fig in THESIS_FIGURES:
+        validate(fig)
+        assert not fig.quote or fig.checks or fig.kind != "field", fig.number
 
 
 def test_visibility_and_statement_rules(tmp_path):
@@ -245,7 +321,8 @@ def test_visibility_and_statement_rules(tmp_path):
     from reproduction.classes import category
     from reproduction.figures import THESIS_FIGURES, ThesisFigure
     cells = _square()
-    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"))
+    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"),
+                       subject=("stress", "damage"))
     faint = _panel(tmp_path, "faint", cells, 0.95 + 0.04 * cells[..., 1])
     verdict = judge(fig, [faint])[0]
     assert category(verdict) == "not visible in this figure" and "rank together" in verdict
