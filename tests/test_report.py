@@ -380,3 +380,50 @@ def test_reader_text_and_units():
     assert forbidden(reader_text("--out /work/main/results/a/b.png", [("/work/main", "")])) == []
     assert figstyle.si_unit("von Mises stress [Pa]", 2.9e7) == ("von Mises stress [MPa]", 1e6)
     assert figstyle.si_unit("strain [-]", 2e-3) == ("strain [-]", 1.0)
+
+
+def test_one_record_per_item_planted_disagreement(tmp_path, monkeypatch):
+    """Every place that states an item's verdict prints it from one record: a second verdict
+    for an item is refused; a hand-written verdict in the readings section that differs from the
+    record stops the report; the committed readings state no verdict of their own, and the
+    report prints the record's beside each of their figure rows."""
+    from reproduction import CHECKOUT
+    from reproduction.record import VerdictRecord, stated
+    record = VerdictRecord()
+    record.set("Figure 2.12", "differs: the thesis says: x; ours: y")
+    record.set("Figure 2.12", "differs: the thesis says: x; ours: y")   # the same: fine
+    with pytest.raises(ValueError, match="two verdicts"):
+        record.set("Figure 2.12", "reproduced: x")
+    record.set("Figure 3.4", "reproduced: penetration 0 m")
+    planted = ("| figure | setting | analysis |\n|---|---|---|\n"
+               "| 2.12 / 3.4 | n = 40 | **reproduced**: the edges agree |\n\n"
+               "In one line: **3.4 differs** (the beam leaves its foundation).\n")
+    assert sorted(record.disagreements(planted)) == [
+        "text: Figure 2.12 stated as 'reproduced', the record says 'differs'",
+        "text: Figure 3.4 stated as 'differs', the record says 'reproduced'"]
+    filled = record.fill_readings(planted)
+    assert "verdict (this report) |" in filled
+    assert "[Figure 2.12](#fig-2-12): **differs**; [Figure 3.4](#fig-3-4): **reproduced** |" in filled
+    committed = (CHECKOUT / "benchmarks" / "readings.md").read_text()
+    assert stated(committed) == []                     # no verdict of its own
+    readings = tmp_path / "readings.md"                # a report whose readings disagree
+    readings.write_text(committed + "\n| figure | analysis |\n|---|---|\n| 2.12 | "
+                        "**reproduced**: planted |\n")
+    from reproduction import build as report
+    monkeypatch.setattr(report, "READINGS", readings)
+    with pytest.raises(ValueError, match="Figure 2.12 stated as 'reproduced'"):
+        report.build(tmp_path / "results")
+    monkeypatch.setattr(report, "READINGS", CHECKOUT / "benchmarks" / "readings.md")
+    report.build(tmp_path / "results")
+    md = (tmp_path / "results" / "report" / "REPORT.md").read_text()
+    rows = {}
+    for line in md.splitlines():
+        cells = [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+        m = re.match(r"\[((?:Figure|Table) [\d.]+)\]\(#", cells[0]) if cells else None
+        if m and len(cells) == 5:
+            rows[m.group(1)] = cells[4]
+    assert len(rows) == 58
+    fidelity = (tmp_path / "results" / "fidelity" / "fidelity.md").read_text()
+    assert len({item for item, _ in stated(md)}) >= 50 and stated(fidelity, default_kind="Table")
+    for item, cls in stated(md) + stated(fidelity, default_kind="Table"):
+        assert rows[item].startswith(cls), (item, cls, rows[item])
