@@ -424,6 +424,42 @@ def test_one_record_per_item_planted_disagreement(tmp_path, monkeypatch):
             rows[m.group(1)] = cells[4]
     assert len(rows) == 58
     fidelity = (tmp_path / "results" / "fidelity" / "fidelity.md").read_text()
+    from reproduction.text import self_contained_problems
+    assert self_contained_problems(tmp_path / "results" / "report") == []
     assert len({item for item, _ in stated(md)}) >= 50 and stated(fidelity, default_kind="Table")
     for item, cls in stated(md) + stated(fidelity, default_kind="Table"):
         assert rows[item].startswith(cls), (item, cls, rows[item])
+
+
+def test_no_claim_about_tables_the_project_has_not(tmp_path):
+    """No text of the product, the records or the report claims agreement with a thesis table
+    the project cannot compute against (Tables 2.1 and 3.3): every tracked text file of the
+    checkout (the tests, which plant claims, aside) and the assumptions every example prints
+    are scanned; a planted claim is found,
+    a negated mention is not."""
+    from damage_dolfinx.catalogue import examples
+    from reproduction import CHECKOUT
+    from reproduction.text import assumption, unsupported_claims
+    assert unsupported_claims('our errors "\n    "which agree with Tables 2.1 and 3.3 with the 1/2')
+    assert unsupported_claims("the rate matches Table 3.3")
+    assert unsupported_claims("Table 2.1 is reproduced within 10 %")
+    assert not unsupported_claims("our errors are never compared with Tables 2.1 and 3.3")
+    assert not unsupported_claims("python benchmarks/reproduction/x.py (Tables 2.1, 3.3)")
+    assert not unsupported_claims("convergence (Table 3.3.3) agrees")  # another number
+    files = subprocess.run(["git", "ls-files"], cwd=CHECKOUT, capture_output=True, text=True,
+                           check=True).stdout.split()
+    found = []
+    for name in files:
+        path = CHECKOUT / name
+        if path.suffix in (".png", ".pdf", ".h5", ".npz", ".xdmf") or not path.is_file() \
+                or name.startswith("tests/"):  # the tests plant claims on purpose
+            continue
+        try:
+            text = path.read_text()
+        except UnicodeDecodeError:
+            continue
+        found += [f"{name}: {c}" for c in unsupported_claims(text)]
+    for ex in examples.catalogue().values():
+        found += [f"{ex.id}: {c}" for a in ex.assumptions
+                  for c in unsupported_claims(assumption(a))]
+    assert found == [], found
