@@ -78,7 +78,7 @@ def build(results: Path) -> Path:
     from damage_dolfinx.catalogue import examples
     from reproduction import reproduce
     from reproduction.checks import judge, run_context
-    from reproduction.figures import THESIS_FIGURES
+    from reproduction.figures import THESIS_FIGURES, mesh_drawn
     results = Path(results).resolve()
     folder = results / FOLDER
     if folder.exists():
@@ -125,6 +125,9 @@ def build(results: Path) -> Path:
                     "report; our convergence plot alone (see the table row)")), "our convergence plot"
         elif fig.kind == "setting":
             verdict, got = _setting_verdict(ex, quick=bool(paths) and paths[0][1] == "quick")
+            note = mesh_drawn(fig, found[0][3].get("command", "") if found and found[0] else "",
+                              ex.n if ex else None)
+            got += f"; {note}" if note and paths else ""
         elif fig.kind == "assumed-setting":
             verdict, got = classify(Evidence(
                 kind="setting", quick=bool(paths) and paths[0][1] == "quick",

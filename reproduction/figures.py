@@ -266,16 +266,51 @@ def figure_number(filename: str):
     return (int(m.group(1)), int(m.group(2)), m.group(3) or "") if m else None
 
 
-#: what a thesis figure draws beside the body (figstyle.draw_guides), by our PNG name: the
-#: foundation under the beam of 3.4/3.5 and the slope plane and obstacle of 3.13 (drawn in
-#: the slope-aligned frame of the run, x1 up the slope)
+#: what a thesis figure draws beside the body (figstyle.draw_guides), by our PNG name, in the
+#: undeformed coordinates of the run: the frictional planes of 2.12/2.13 and 3.11/3.12, the
+#: contact part of 2.17/2.18, the foundation of 2.20/2.21 and of 3.4/3.5, the obstacle of
+#: 3.7/3.8 and the slope plane and obstacle of 3.13 (drawn in the slope-aligned frame of the
+#: run, x1 up the slope)
+_PLANES_2_2 = [{"line": [[0.0, 0.0], [4.0, 0.0]], "label": "the lower frictional plane (g1 = 45)"},
+               {"line": [[0.0, 4.0], [4.0, 4.0]], "label": "the upper frictional plane (g2 = 1000)"}]
+_PLANES_3_2 = [{"line": [[0.0, 0.0], [4.0, 0.0]], "label": "the lower frictional plane (g = 1000)"},
+               {"line": [[0.0, 2.0], [4.0, 2.0]], "label": "the upper frictional plane (g = 1)"}]
+_FOUNDATION_2_3_2 = [{"line": [[0.0, 0.0], [0.0, 1.0]],
+                      "label": "the foundation (contact part {0}x[0,1])"}]
+_FOUNDATION_2_3_3 = [{"line": [[3.0, 0.0], [4.0, 0.0]],
+                      "label": "the foundation (contact part [3,4]x{0})"}]
+_OBSTACLE_3_1_3 = [{"line": [[1.0, 1.0], [2.0, 1.0]],
+                    "label": "the deformable obstacle (contact part [1,2]x{1})"}]
 GUIDES = {
+    **{name: _PLANES_2_2 for name in ("figure_2_12_left.png", "figure_2_13.png")},
+    **{name: _PLANES_3_2 for name in ("figure_3_11.png", "figure_3_12.png")},
+    **{name: _FOUNDATION_2_3_2 for name in ("figure_2_17_t0.png", "figure_2_17_t2.png",
+                                            "figure_2_18.png")},
+    **{name: _FOUNDATION_2_3_3 for name in ("figure_2_20_t0.png", "figure_2_20_t0.5.png",
+                                            "figure_2_21.png")},
+    **{name: _OBSTACLE_3_1_3 for name in ("figure_3_7_undamaged.png", "figure_3_7_damaged.png",
+                                          "figure_3_8_undamaged.png", "figure_3_8_damaged.png")},
     "figure_3_4.png": [{"line": [[0.0, 0.0], [3.0, 0.0]], "label": "the deformable foundation"}],
     "figure_3_5.png": [{"line": [[0.0, 0.0], [3.0, 0.0]], "label": "the deformable foundation"}],
     "figure_3_13.png": [{"line": [[0.0, 0.0], [2.0, 0.0]],
                          "label": "the slope plane (bottom; x1 up the slope, Tresca g = 1)"},
                         {"line": [[0.0, 0.0], [0.0, 1.0]], "label": "the obstacle (left, g = 1)"}],
 }
+
+def mesh_drawn(fig: ThesisFigure, command: str, default_n=None) -> str:
+    """What mesh our setting figure draws, when the thesis's caption names another ('' when it
+    draws the caption's mesh, or the caption names none): the run's ``--n``, else the
+    example's default ``default_n``."""
+    want = re.search(r"\bn = (\d+)", fig.thesis_run or "")
+    if fig.kind != "setting" or not want:
+        return ""
+    given = re.search(r"--n (\d+)", command or "")
+    ours = int(given.group(1)) if given else default_n
+    if ours is None or ours == int(want.group(1)):
+        return ""
+    return (f"drawn on our mesh n = {ours}; the thesis's Figure {fig.number} shows its mesh for "
+            f"n = {want.group(1)}")
+
 
 #: figures that mark the hinges of the arch's collapse mechanism (from its run's summary.json)
 HINGE_FIGURES = ("figure_2_8.png", "figure_2_9.png")
