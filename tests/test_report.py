@@ -463,3 +463,35 @@ def test_no_claim_about_tables_the_project_has_not(tmp_path):
         found += [f"{ex.id}: {c}" for a in ex.assumptions
                   for c in unsupported_claims(assumption(a))]
     assert found == [], found
+
+
+def test_contact_parts_drawn_and_setting_meshes_named():
+    """Every field figure whose thesis figure draws a contact part gets it as a guide (the
+    frictional planes, the contact part, the foundation, the obstacle), placed on the run's
+    contact boundary; a setting figure drawn on another mesh than its caption's says which."""
+    from reproduction.figures import THESIS_FIGURES, guides, mesh_drawn
+    expected = {  # our PNG: the contact part's end points (undeformed coordinates)
+        "figure_2_12_left.png": [[[0, 0], [4, 0]], [[0, 4], [4, 4]]],
+        "figure_2_13.png": [[[0, 0], [4, 0]], [[0, 4], [4, 4]]],
+        "figure_3_11.png": [[[0, 0], [4, 0]], [[0, 2], [4, 2]]],
+        "figure_3_12.png": [[[0, 0], [4, 0]], [[0, 2], [4, 2]]],
+        "figure_2_17_t0.png": [[[0, 0], [0, 1]]], "figure_2_17_t2.png": [[[0, 0], [0, 1]]],
+        "figure_2_18.png": [[[0, 0], [0, 1]]],
+        "figure_2_20_t0.png": [[[3, 0], [4, 0]]], "figure_2_20_t0.5.png": [[[3, 0], [4, 0]]],
+        "figure_2_21.png": [[[3, 0], [4, 0]]],
+        "figure_3_7_undamaged.png": [[[1, 1], [2, 1]]], "figure_3_7_damaged.png": [[[1, 1], [2, 1]]],
+        "figure_3_8_undamaged.png": [[[1, 1], [2, 1]]], "figure_3_8_damaged.png": [[[1, 1], [2, 1]]],
+        "figure_3_4.png": [[[0, 0], [3, 0]]], "figure_3_5.png": [[[0, 0], [3, 0]]],
+    }
+    for png, lines in expected.items():
+        drawn = [g["line"] for g in guides(png) if "line" in g]
+        assert drawn == lines and all(g.get("label") for g in guides(png)), png
+    assert guides("figure_2_14.png") == []
+    fig_2_1 = next(f for f in THESIS_FIGURES if f.number == "2.1")
+    assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --n 5 --quiet", 20) == \
+        "drawn on our mesh n = 5; the thesis's Figure 2.1 shows its mesh for n = 10"
+    assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --quiet", 20).startswith(
+        "drawn on our mesh n = 20")
+    assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --n 10", 20) == ""
+    fig_2_3 = next(f for f in THESIS_FIGURES if f.number == "2.3")   # no mesh in its caption
+    assert mesh_drawn(fig_2_3, "damage-dolfinx run 2.1-ex2a --n 5", 20) == ""
