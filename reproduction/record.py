@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import re
 
-from reproduction.classes import CLASSES, category
+from reproduction.classes import CLASSES, QUICK, category, is_quick
 
 _CLASS = "|".join(re.escape(c) for c in sorted(CLASSES, key=len, reverse=True))
 _NUMBERS = r"\d\.\d+(?:\s*(?:/|,|and)\s*\d\.\d+)*"
@@ -106,6 +106,7 @@ class VerdictRecord:
                 items = _items(m.group(1), m.group(2), "Figure") if m else []
                 verdicts = "; ".join(
                     f"[{item}](#fig-{item.split()[1].replace('.', '-')}): "
-                    f"**{category(self[item])}**" for item in items if item in self)
+                    f"**{category(self[item])}**" + (QUICK if is_quick(self[item]) else "")
+                    for item in items if item in self)
                 out.append(line + f" {verdicts or '-'} |")
         return "\n".join(out) + ("\n" if text.endswith("\n") else "")

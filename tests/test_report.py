@@ -495,3 +495,24 @@ def test_contact_parts_drawn_and_setting_meshes_named():
     assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --n 10", 20) == ""
     fig_2_3 = next(f for f in THESIS_FIGURES if f.number == "2.3")   # no mesh in its caption
     assert mesh_drawn(fig_2_3, "damage-dolfinx run 2.1-ex2a --n 5", 20) == ""
+
+
+def test_figure_3_21_stress_location_is_tested(tmp_path):
+    """Figure 3.21 quotes where the highest stress is ('the central region'): it is tested along
+    the body's length (its principal axis, so a slanted body is measured along itself)."""
+    import numpy as np
+    from reproduction.checks import judge
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES
+    fig = next(f for f in THESIS_FIGURES if f.number == "3.21")
+    cells = _square(8) * np.array([4.0, 0.5])                      # a bar 4 x 0.5 ...
+    c, s = np.cos(-0.8), np.sin(-0.8)
+    cells = cells @ np.array([[c, s], [-s, c]])                    # ... slanted like the wrench
+    along = (cells @ np.array([c, s]))                             # position along the bar
+    context = {"T_full": 1.0, "status": "completed", "t_final": 1.0, "departures": []}
+    for peak, expected in ((2.0, "reproduced"), (0.3, "differs")):
+        stress = 1e6 * np.exp(-(along - peak) ** 2)
+        npz = _panel(tmp_path, f"bar{peak}", cells, np.ones(cells.shape[:2]), stress=stress)
+        verdict = judge(fig, [npz], context=context)[0]
+        assert category(verdict) == expected, verdict
+    assert "% of the body's length" in verdict
