@@ -337,7 +337,8 @@ def _fidelity_table(doc, t, record):
              f"{t['ratio_median']:.3g}, min {t['ratio_min']:.3g}, max {t['ratio_max']:.3g}; fitted "
              f"rate in h + k: thesis {t['rate_thesis_common_cells']:.3f}, ours {t['rate_ours']:.3f}."
              + (f" Median ratio of our error components alone: {comp}." if comp else "")
-             + f" Source: {t['source']} (`{_shown(Path(t['folder']))}`). Verdict: **{record['Table ' + t['table']]}**.")
+             + f" Source: {t['source']} (`{_shown(Path(t['folder']))}`). Verdict: "
+               f"**{record['Table ' + t['table']]}**.")
 
 
 def markdown_cells(t) -> str:

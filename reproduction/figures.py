@@ -168,7 +168,8 @@ THESIS_FIGURES = [
        "and at the right lower corner'", ["figure_2_25.png"],
        ("physical", "localised", "min_zeta_top_or_lower_right"), thesis_run="n = 64, k = 0.002",
        quote="We notice now that the highest stressed areas (and so, the most damaged ones) are "
-       "located at the upper boundary and at the right lower corner.", subject=("stress", "damage")),
+       "located at the upper boundary and at the right lower corner.",
+       subject=("stress", "damage")),
     _f("2.26", "2.4-ex2", "unit square without clamping, large friction bound",
        ["figure_2_26.png"], kind="setting"),
     _f("2.27", "2.4-ex2", "deformed mesh at t = 1: 'the contact boundary remains "
@@ -272,7 +273,8 @@ def figure_number(filename: str):
 #: 3.7/3.8 and the slope plane and obstacle of 3.13 (drawn in the slope-aligned frame of the
 #: run, x1 up the slope)
 _PLANES_2_2 = [{"line": [[0.0, 0.0], [4.0, 0.0]], "label": "the lower frictional plane (g1 = 45)"},
-               {"line": [[0.0, 4.0], [4.0, 4.0]], "label": "the upper frictional plane (g2 = 1000)"}]
+               {"line": [[0.0, 4.0], [4.0, 4.0]],
+                "label": "the upper frictional plane (g2 = 1000)"}]
 _PLANES_3_2 = [{"line": [[0.0, 0.0], [4.0, 0.0]], "label": "the lower frictional plane (g = 1000)"},
                {"line": [[0.0, 2.0], [4.0, 2.0]], "label": "the upper frictional plane (g = 1)"}]
 _FOUNDATION_2_3_2 = [{"line": [[0.0, 0.0], [0.0, 1.0]],

@@ -135,7 +135,8 @@ def forbidden(text: str) -> list:
 
 def self_contained_problems(folder) -> list:
     """What keeps a report folder from standing alone: forbidden words and paths in its
-    documents, claims of agreement with tables the project has not, and links to images that are absolute, leave the folder or are missing."""
+    documents, claims of agreement with tables the project has not, and links
+    to images that are absolute, leave the folder or are missing."""
     folder = Path(folder)
     problems = []
     for doc in sorted(folder.glob("*.html")) + sorted(folder.glob("*.md")):

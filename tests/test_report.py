@@ -403,7 +403,8 @@ def test_one_record_per_item_planted_disagreement(tmp_path, monkeypatch):
         "text: Figure 3.4 stated as 'differs', the record says 'reproduced'"]
     filled = record.fill_readings(planted)
     assert "verdict (this report) |" in filled
-    assert "[Figure 2.12](#fig-2-12): **differs**; [Figure 3.4](#fig-3-4): **reproduced** |" in filled
+    assert ("[Figure 2.12](#fig-2-12): **differs**; [Figure 3.4](#fig-3-4): **reproduced** |"
+            in filled)
     committed = (CHECKOUT / "benchmarks" / "readings.md").read_text()
     assert stated(committed) == []                     # no verdict of its own
     readings = tmp_path / "readings.md"                # a report whose readings disagree
@@ -479,8 +480,8 @@ def test_contact_parts_drawn_and_setting_meshes_named():
         "figure_2_18.png": [[[0, 0], [0, 1]]],
         "figure_2_20_t0.png": [[[3, 0], [4, 0]]], "figure_2_20_t0.5.png": [[[3, 0], [4, 0]]],
         "figure_2_21.png": [[[3, 0], [4, 0]]],
-        "figure_3_7_undamaged.png": [[[1, 1], [2, 1]]], "figure_3_7_damaged.png": [[[1, 1], [2, 1]]],
-        "figure_3_8_undamaged.png": [[[1, 1], [2, 1]]], "figure_3_8_damaged.png": [[[1, 1], [2, 1]]],
+        **{f"figure_3_{n}_{case}.png": [[[1, 1], [2, 1]]] for n in (7, 8)
+           for case in ("undamaged", "damaged")},
         "figure_3_4.png": [[[0, 0], [3, 0]]], "figure_3_5.png": [[[0, 0], [3, 0]]],
     }
     for png, lines in expected.items():

@@ -45,7 +45,8 @@ def _guides(npz, file):
     import json
     from reproduction.figures import guides
     summary_path = npz.parent / "summary.json" if npz else None
-    summary = json.loads(summary_path.read_text()) if summary_path and summary_path.is_file() else None
+    summary = (json.loads(summary_path.read_text())
+               if summary_path and summary_path.is_file() else None)
     return guides(file, summary)
 
 
