@@ -516,4 +516,4 @@ def test_figure_3_21_stress_location_is_tested(tmp_path):
         npz = _panel(tmp_path, f"bar{peak}", cells, np.ones(cells.shape[:2]), stress=stress)
         verdict = judge(fig, [npz], context=context)[0]
         assert category(verdict) == expected, verdict
-    assert "% of the body's length" in verdict
+    assert "% of the body's length from its middle" in verdict
