@@ -88,28 +88,13 @@ def share_pair_scales(out: Path, index: dict) -> list:
     return done
 
 
-def stamp(png: Path, text: str, source: Path = None):
-    """Write ``png`` as ``source`` (default: itself) with one line of ``text`` under it."""
-    plt = figstyle.plt()
-    img = plt.imread(source or png)
-    h, w = img.shape[:2]
-    dpi, strip = 100, 30
-    fig = plt.figure(figsize=(w / dpi, (h + strip) / dpi), dpi=dpi)
-    ax = fig.add_axes([0, strip / (h + strip), 1, h / (h + strip)])
-    ax.imshow(img)
-    ax.axis("off")
-    fig.text(0.5, 0.5 * strip / (h + strip), text, ha="center", va="center", fontsize=9,
-             color="0.1")
-    fig.savefig(png, dpi=dpi)
-    plt.close(fig)
-
-
 def stamp_settings(out: Path, index: dict, from_runs=True) -> list:
     """Say on each setting figure which mesh it draws when the thesis's caption names another
     (reproduction.figures.mesh_drawn); from the run's own copy (``from_runs``), so that a
     second call does not stamp twice. Returns the files stamped."""
     from damage_dolfinx.catalogue import examples
     from reproduction.figures import THESIS_FIGURES, mesh_drawn
+    from reproduction.plots import note_under
     done = []
     for fig in THESIS_FIGURES:
         for file in fig.files:
@@ -121,7 +106,7 @@ def stamp_settings(out: Path, index: dict, from_runs=True) -> list:
                         and r["variant"] == entry["variant"]), None)
             source = Path(run["folder"]) / entry["source"] if run and entry.get("source") else None
             if note and (not from_runs or (source and source.is_file())):
-                stamp(out / file, note, source if from_runs else None)
+                note_under(out / file, note, source if from_runs else None)
                 done.append(file)
     return done
 
