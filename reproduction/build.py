@@ -29,6 +29,7 @@ from reproduction.sources import (Figures, _bridge_summary, _convergence_png, _f
 from reproduction.text import assumption, example_ref
 from reproduction.classes import QUICK, Evidence, classify, counts as class_counts, headline
 from reproduction.verdicts import CLASSES, category, known_differences, summary_table, table_rows
+from reproduction.record import VerdictRecord
 
 SECTION_TITLES = {
     "2.1": "Section 2.1: quasistatic elastic body with damage",
@@ -41,6 +42,8 @@ SECTION_TITLES = {
 }
 #: the folder ``make report`` writes inside the results folder
 FOLDER = "report"
+#: the readings of the thesis data (a hand-written record; it states no verdict of its own)
+READINGS = REPO / "benchmarks" / "readings.md"
 
 
 def quick_difference(command: str, ex, thesis_run: str = "") -> str:
@@ -75,7 +78,7 @@ def build(results: Path) -> Path:
     from damage_dolfinx.catalogue import examples
     from reproduction import reproduce
     from reproduction.checks import judge, run_context
-    from reproduction.figures import THESIS_FIGURES
+    from reproduction.figures import THESIS_FIGURES, mesh_drawn
     results = Path(results).resolve()
     folder = results / FOLDER
     if folder.exists():
@@ -84,11 +87,11 @@ def build(results: Path) -> Path:
     doc = Doc(folder, roots=[(results, results.name), (REPO, "")])
     catalogue = {k: ex.with_reading() for k, ex in examples.catalogue().items()}
     figs = Figures(results)
-    fidelity = _fidelity(results) or {"tables": []}
+    fidelity, write_fidelity = _fidelity(results)
     conv_index = _load_json(results / "convergence" / "index.json") or {}
     conv_commands = {(s["example"], s["variant"]): s["command"] for s in conv_index.get("studies", [])}
     bridge, bridge_path = _bridge_summary(results)
-    readings = REPO / "benchmarks" / "readings.md"
+    readings = READINGS
 
     # ---- verdicts of every thesis figure and table (rows of the summary, thesis order)
     rows = table_rows(fidelity, results, _study_folder, _load_json, _sort_key)
@@ -122,6 +125,9 @@ def build(results: Path) -> Path:
                     "report; our convergence plot alone (see the table row)")), "our convergence plot"
         elif fig.kind == "setting":
             verdict, got = _setting_verdict(ex, quick=bool(paths) and paths[0][1] == "quick")
+            note = mesh_drawn(fig, found[0][3].get("command", "") if found and found[0] else "",
+                              ex.n if ex else None)
+            got += f"; {note}" if note and paths else ""
         elif fig.kind == "assumed-setting":
             verdict, got = classify(Evidence(
                 kind="setting", quick=bool(paths) and paths[0][1] == "quick",
@@ -150,7 +156,13 @@ def build(results: Path) -> Path:
                          verdict=verdict))
         figure_blocks.setdefault(fig.example, []).append((fig, paths, got, verdict, quick))
     rows.sort(key=lambda r: r["key"])
-    counts = class_counts(r["verdict"] for r in rows)
+    # ---- the one record: every place below prints an item's verdict from it
+    record = VerdictRecord()
+    for r in rows:
+        record.set(r["item"], r["verdict"])
+    for t in fidelity["tables"]:
+        t["verdict"] = record[f"Table {t['table']}"]
+    counts = class_counts(verdict for _, verdict in record.items())
     _title(doc, figs, counts, len(rows))
     _contents(doc, readings)
     summary_table(doc, rows, fidelity)
@@ -160,14 +172,21 @@ def build(results: Path) -> Path:
         doc.para("Where the stated data of an example do not reproduce the thesis's results, a "
                  "*reading* changes as little as possible and is compared with the stated data "
                  "(`benchmarks/readings.md`).")
-        doc.markdown_table(readings.read_text())
+        doc.markdown_table(record.fill_readings(readings.read_text()))
     _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_commands, bridge,
-              bridge_path, reproduce)
+              bridge_path, reproduce, record)
     _wall_times(doc, figs.sources[0][1] if figs.sources else None, conv_index)
     _performance(doc, results)
     _step_floor(doc)
     _threed_scaling(doc)
-    (folder / "REPORT.md").write_text(doc.to_markdown())
+    markdown = doc.to_markdown()
+    fidelity_md = write_fidelity(fidelity, results / "fidelity") if write_fidelity else ""
+    problems = (record.disagreements(markdown, "REPORT.md")
+                + record.disagreements(fidelity_md, "fidelity.md", default_kind="Table"))
+    if problems:  # a verdict stated anywhere but from the record: no report with two verdicts
+        raise ValueError("the report states verdicts that differ from its record: "
+                         + "; ".join(problems))
+    (folder / "REPORT.md").write_text(markdown)
     page = folder / "REPORT.html"
     page.write_text(doc.to_html("damage-dolfinx: reproduction of Campo (2007)"))
     return page
@@ -224,7 +243,7 @@ def _contents(doc, readings):
 
 
 def _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_commands, bridge,
-              bridge_path, reproduce):
+              bridge_path, reproduce, record):
     """Every thesis section: its examples' runs, figures, tables and assumptions."""
     by_table = {t.get("study"): t for t in fidelity["tables"]}
     for section, title in SECTION_TITLES.items():
@@ -239,7 +258,8 @@ def _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_comma
                          f"`{run['command']}` ({_status(run)}, {run['wall_time_s']} s)"
                          + (f"; {quick_difference(run['command'], ex)}" if mode == "quick" else ""))
             thesis_files = set()
-            for fig, paths, got, verdict, quick in figure_blocks.get(ex.id, []):
+            for fig, paths, got, _, quick in figure_blocks.get(ex.id, []):
+                verdict = record[f"Figure {fig.number}"]
                 thesis_files.update(fig.files)
                 if not paths:
                     doc.raw(f'<p id="{fig.anchor}"><b>Figure {fig.number}</b>: not produced '
@@ -257,7 +277,7 @@ def _sections(doc, results, catalogue, figs, fidelity, figure_blocks, conv_comma
             for variant in (reproduce.VARIANTS.get(ex.id) or {"": {}}) if ex.convergence else ():
                 name = ex.id + (f"-{variant}" if variant else "")
                 if name in by_table and "ratio_median" in by_table[name]:
-                    _fidelity_table(doc, by_table[name])
+                    _fidelity_table(doc, by_table[name], record)
                 _convergence_of(doc, results, ex.id, variant, conv_commands,
                                 full=name not in by_table)
             if ex.id == "2.1-ex3" and bridge:
@@ -284,7 +304,7 @@ def _sort_key(number: str, kind: int):
     return (int(a), int(b), 0, "")
 
 
-def _fidelity_table(doc, t):
+def _fidelity_table(doc, t, record):
     """The thesis's table beside ours, cell by cell, with the ratio."""
     anchor = f"table-{t['table'].replace('.', '-')}"
     ks = t["k"]
@@ -317,7 +337,8 @@ def _fidelity_table(doc, t):
              f"{t['ratio_median']:.3g}, min {t['ratio_min']:.3g}, max {t['ratio_max']:.3g}; fitted "
              f"rate in h + k: thesis {t['rate_thesis_common_cells']:.3f}, ours {t['rate_ours']:.3f}."
              + (f" Median ratio of our error components alone: {comp}." if comp else "")
-             + f" Source: {t['source']} (`{_shown(Path(t['folder']))}`). Verdict: **{t['verdict']}**.")
+             + f" Source: {t['source']} (`{_shown(Path(t['folder']))}`). Verdict: "
+               f"**{record['Table ' + t['table']]}**.")
 
 
 def markdown_cells(t) -> str:

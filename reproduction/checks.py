@@ -65,6 +65,15 @@ def _rel(base, i):
     return ((base[i] - lo) / np.where(hi > lo, hi - lo, 1)).tolist()
 
 
+def _along_length(base):
+    """Each vertex's position along the body's length, 0 to 1: its projection on the principal
+    axis of the vertex cloud (the handle of a slanted wrench, the long side of a beam)."""
+    centred = base - base.mean(0)
+    axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+    s = centred @ axis
+    return (s - s.min()) / max(np.ptp(s), 1e-300)
+
+
 def quadrant(rel) -> str:
     x, y = rel
     return ("lower" if y < 1 / 3 else "upper" if y > 2 / 3 else "middle") + " " + \
@@ -81,6 +90,7 @@ def measure(npz, related=()) -> dict:
     dmax = float(d.max()) or 1.0
     rel = (base - base.min(0)) / np.where(np.ptp(base, 0) > 0, np.ptp(base, 0), 1)
     m.update(u_max=float(d.max()), size=float(np.hypot(*np.ptp(base, 0))),
+
              u_top=float(d[rel[:, 1] > 0.999].max(initial=0) / dmax),
              u_bottom=float(d[rel[:, 1] < 0.001].max(initial=0) / dmax))
     others = [fields(r) for r in related if r]
@@ -98,7 +108,8 @@ def measure(npz, related=()) -> dict:
             m["rank_stress_damage"] = rank_correlation(stress, -z)
     if stress is not None:
         i = int(np.argmax(stress))
-        m.update(stress_max=float(stress.max()), stress_max_at=_rel(base, i))
+        m.update(stress_max=float(stress.max()), stress_max_at=_rel(base, i),
+                 stress_max_along=float(_along_length(base)[i]))
         band = rel.min(1) < 0.05
         m["stress_band_ratio"] = float(stress[band].mean() / max(stress[~band].mean(), 1e-300))
     for o in others:  # a pair of runs on one mesh (Figures 2.4 and 2.5)
@@ -163,7 +174,62 @@ CHECKS = {  # name: (what is tested, predicate(measures, context) -> bool or Non
                           lambda m, c: c["u_last"] > 1.01 * c["u_first"]),
     "damage_increases_strain": ("damaged run strains more than the undamaged one (> 1 %)",
                                 lambda m, c: c["strain_damaged"] > 1.01 * c["strain_undamaged"]),
+    "as_drawn": ("a deformation of the size the thesis draws: amplified by the thesis's factor, "
+                 "the largest displacement stays below the body's size",
+                 lambda m, c: c["thesis_amplification"] * m["u_max"] <= m["size"]),
+    "stress_central": ("highest stress in the central region (the middle third of the body's "
+                       "length, along its principal axis)",
+                       lambda m, c: abs(m["stress_max_along"] - 0.5) <= 1 / 6),
 }
+
+#: what each check is about (reproduction.figures.SUBJECTS): a figure may use a check only
+#: when its quoted statement is about every subject the check tests
+SUBJECTS = {
+    "physical": ("damage",), "localised": ("damage",), "min_zeta_lower_right": ("damage",),
+    "min_zeta_top_or_lower_right": ("damage",), "min_zeta_left": ("damage",),
+    "damage_at_top_or_bottom": ("damage",), "contact_bands": ("stress", "damage"),
+    "colocated": ("stress", "damage"), "stress_pattern_same": ("stress",),
+    "damage_pattern_differs": ("damage",), "top_fixed_bottom_moves": ("configuration",),
+    "bottom_fixed": ("configuration",), "no_penetration": ("contact",), "stressed": ("stress",),
+    "displaced": ("configuration",), "position_recovers": ("configuration",),
+    "four_hinges": ("number",), "probe_reaches_star": ("damage",),
+    "minimum_at_edges": ("damage",), "deformation_grows": ("configuration",),
+    "damage_increases_strain": ("configuration",), "as_drawn": ("configuration",),
+    "stress_central": ("stress",),
+}
+
+#: a share of the nodes more than 0.09 above zeta* below which the damage has no pattern to
+#: judge (the body is at zeta* nearly everywhere)
+PATTERN_SHARE = 0.1
+
+
+def _contact_premise(m, c):
+    """(holds, reason): contact exists where penetration is judged (the contact length or area
+    at the final time, or over the run where the penetration is the largest over the run)."""
+    length = c.get("contact_judged")
+    if length is None:
+        return None, "no contact length recorded"
+    when = "over the run" if c.get("penetration_over_run") else "at the final time"
+    return length > 0, (f"no contact {when} (contact length {length:.3g}): no penetration "
+                        f"without contact proves nothing")
+
+
+def _pattern_premise(m, c):
+    """(holds, reason): the damage is away from zeta* somewhere, so that it has a pattern."""
+    if "area_near_star" not in m:
+        return None, "no damage field"
+    away = 1 - m["area_near_star"]
+    return away >= PATTERN_SHARE, (f"{100 * m['area_near_star']:.0f} % of the nodes within 0.09 "
+                                   f"of ζ* (fewer than {100 * PATTERN_SHARE:.0f} % away from "
+                                   f"it): a pattern inside a fully damaged body proves nothing")
+
+
+#: the premise each check rests on: where it fails, the check fails with its reason
+PREMISES = {"no_penetration": _contact_premise,
+            **{name: _pattern_premise for name in (
+                "min_zeta_lower_right", "min_zeta_top_or_lower_right", "min_zeta_left",
+                "damage_at_top_or_bottom", "contact_bands", "colocated",
+                "damage_pattern_differs")}}
 
 
 def pair_context(fig, npzs) -> dict:
@@ -197,10 +263,16 @@ def run_context(folder) -> dict:
         if col("u_L2"):
             u = col("u_L2")
             c.update(u_L2_first=u[0], u_L2_last=u[-1], u_L2_max=max(u))
+        contact = col("contact_length") or col("contact_area")
         if col("penetration_rms"):
             c["penetration_last"] = col("penetration_rms")[-1]
+            if contact:
+                c["contact_judged"] = contact[-1]
         elif summary.get("max_penetration") is not None:  # largest over the run (the wrench)
             c["penetration_last"] = float(summary["max_penetration"])
+            c["penetration_over_run"] = True
+            if contact:
+                c["contact_judged"] = max(contact)
         if col("zeta_probe"):
             c["probe_min"] = min(col("zeta_probe"))
         if rows:
@@ -240,6 +312,13 @@ NUMBERS = {
     "position_recovers": lambda m, c: f"||u||_L2 {c['u_L2_first']:.3g} m at t = 0, "
                                       f"{c['u_L2_last']:.3g} m at the end",
     "four_hinges": lambda m, c: f"{c['hinges']} mechanism hinges",
+    "as_drawn": lambda m, c: f"max |u| {m['u_max']:.3g} m on a body of size {m['size']:.3g} m: "
+                             f"x{c['thesis_amplification']:g} (the thesis's factor) gives "
+                             f"{c['thesis_amplification'] * m['u_max'] / m['size']:.2g} times "
+                             f"its size",
+    "stress_central": lambda m, c: f"highest stress "
+                                   f"{100 * abs(m['stress_max_along'] - 0.5):.0f} % of the "
+                                   f"body's length from its middle",
     "probe_reaches_star": lambda m, c: f"min ζ(0, 6) = {c['probe_min']:.3g}",
     "minimum_at_edges": lambda m, c: "at an edge" if c["last_min_at_edge"] else "not at an edge",
     "deformation_grows": lambda m, c: f"max |u| {c['u_first']:.4g} m, then {c['u_last']:.4g} m "
@@ -270,7 +349,11 @@ def evidence(fig, npzs, related=(), context=None):
     """(Evidence of one field figure, what we get): the checks of the quoted statement measured
     on the figure's data, the departures of its run, an early stop, what the figure cannot show."""
     from reproduction.classes import ONE_COLOUR, Evidence
+    from reproduction.figures import validate
+    validate(fig)
     c = dict(context or {}, **pair_context(fig, npzs))
+    if fig.thesis_amplification:
+        c["thesis_amplification"] = fig.thesis_amplification
     first = next((n for n in npzs if n), None)
     m = measure(first, related) if first else {}
     checks = []
@@ -281,6 +364,13 @@ def evidence(fig, npzs, related=(), context=None):
             number = NUMBERS[name](m, c) if name in NUMBERS else ""
         except (KeyError, TypeError, IndexError, ValueError, ZeroDivisionError):
             ok, number = None, ""
+        if ok is not None and name in PREMISES:  # a check counts only when its premise holds
+            holds, reason = PREMISES[name](m, c)
+            if holds is None:
+                ok, number = None, ""
+            elif not holds:
+                ok, number = False, f"{number}; premise fails: {reason}" if number else \
+                    f"premise fails: {reason}"
         checks.append((desc, ok, number))
     zs = m.get("zeta_star", 0.01)
     if fig.about_damage and "zeta_min" in m and 1 - m["zeta_min"] < NO_DAMAGE:
@@ -297,6 +387,7 @@ def evidence(fig, npzs, related=(), context=None):
                      f"{m['zeta_max']:.3g}]) is one colour")
     got = describe(m, c, fig.checks)
     e = Evidence(kind="result", statement=bool(fig.checks), no_statement=fig.no_statement,
+                 quote=fig.quote,
                  checks=checks, departures=list(c.get("departures") or []),
                  stopped_early=stopped_early(fig, c), invisible=invisible,
                  quick=bool(c.get("quick")))

@@ -5,7 +5,8 @@ an item's data show (:class:`Evidence`). The report's summary, its captions and
 The rules, in the order they are applied (the first that applies gives the class):
 
 1. **not comparable**, when the item was not produced; when the thesis states nothing about
-   it that could be tested (a figure that only shows what is plotted, a withheld table); when
+   it that could be tested (a figure that only shows what is plotted, a withheld table; refused
+   when the item quotes a thesis statement: that statement is tested); when
    its run stops before the time the thesis's statement is about (an early stop is never
    evidence); or when nothing the statement names could be measured.
 2. **drawn as stated**: a setting figure that draws the geometry and boundary layout the thesis
@@ -13,10 +14,15 @@ The rules, in the order they are applied (the first that applies gives the class
 3. **setting assumed**: a setting figure whose geometry or layout the thesis does not give (or
    gives inconsistently); ours is an assumption, named.
 4. **differs**: a check of the quantity the thesis sentence names fails. The verdict names the
-   quantity and quotes our number. A drawing that is hard to read is not a failed check.
+   quantity and quotes our number. A drawing that is hard to read is not a failed check. A
+   check counts only when its premise holds (contact exists where penetration is judged; the
+   damage is away from ζ* where its pattern is judged); where the premise fails, the check
+   fails with that reason. Each statement is tagged with its subject (damage, stress,
+   configuration, contact, a number) and is judged only by the checks of that subject.
 5. **not visible in this figure**: every check holds (the data carry the statement), but the
    figure cannot show it: the damage field spans less than ``ONE_COLOUR`` of the fixed colour
-   scale [ζ*, 1], or two fields that should differ are the same colours.
+   scale [ζ*, 1], or two fields that should differ are the same colours (statements about the
+   damage only).
 6. **reproduced under a reading**: every check holds, on data that depart from the stated
    text. Each departure is named with its basis (supported by the text, taken from another
    place of the text, fitted to the thesis's results, or against the text).
@@ -44,9 +50,13 @@ RULES = {
     "setting assumed": "a setting figure whose geometry or layout the thesis does not give; "
                        "ours is an assumption",
     "not visible in this figure": "the data carry the statement (every check holds) but the "
-                                  "figure cannot show it (a damage range under 5 % of the "
-                                  "fixed scale, or two fields in the same colours)",
-    "differs": "a check of the quantity the thesis sentence names fails; the number is quoted",
+                                  "figure cannot show it (a statement about the damage: a "
+                                  "damage range under 5 % of the fixed scale, or two fields in "
+                                  "the same colours)",
+    "differs": "a check of the quantity the thesis sentence names fails (the checks of the "
+               "statement's subject only), or its premise fails (no contact where penetration "
+               "is judged, damage at ζ* nearly everywhere where a pattern is judged); the "
+               "number is quoted",
     "not comparable": "nothing to test: not produced, no statement of its own in the thesis, a "
                       "withheld table, nothing measured, or a run that stops before the "
                       "thesis's time (never evidence)",
@@ -75,6 +85,7 @@ class Evidence:
     missing: str = ""                    # why the item was not produced ('' if it was)
     statement: bool = True               # the thesis states something testable about it
     no_statement: str = ""               # why not (for the verdict)
+    quote: str = ""                      # the thesis sentence the row quotes ('' if none)
     checks: list = field(default_factory=list)
     departures: list = field(default_factory=list)
     stopped_early: str = ""              # the run stops before the thesis's time: how
@@ -107,6 +118,9 @@ def _classify(e: Evidence) -> str:
             return f"setting assumed: {e.layout_assumed}"
         return "drawn as stated: a drawing of the geometry and layout the text states, not a result"
     if not e.statement:
+        if e.quote:  # the row quotes the very sentence a "nothing to test" would deny
+            raise ValueError(f"a 'nothing to test' verdict beside a quoted statement is refused: "
+                             f"test “{e.quote[:60]}...” or quote nothing")
         return f"not comparable: {e.no_statement or 'the thesis states nothing to test here'}"
     if e.stopped_early:
         return f"not comparable: {e.stopped_early}; a run that stops early is no evidence"

@@ -43,3 +43,23 @@ def thesis_beside_ours(entry: dict, path: Path, title: str) -> Path:
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return path
+
+
+def note_under(png: Path, text: str, source: Path = None) -> Path:
+    """Write ``png`` as ``source`` (default: ``png`` itself) with one line of ``text`` under it
+    (what a setting figure draws that its thesis caption does not: reproduction.figures.
+    mesh_drawn)."""
+    from damage_dolfinx.viz import figstyle
+    plt = figstyle.plt()
+    img = plt.imread(source or png)
+    h, w = img.shape[:2]
+    dpi, strip = 100, 30
+    fig = plt.figure(figsize=(w / dpi, (h + strip) / dpi), dpi=dpi)
+    ax = fig.add_axes([0, strip / (h + strip), 1, h / (h + strip)])
+    ax.imshow(img)
+    ax.axis("off")
+    fig.text(0.5, 0.5 * strip / (h + strip), text, ha="center", va="center", fontsize=9,
+             color="0.1")
+    fig.savefig(png, dpi=dpi)
+    plt.close(fig)
+    return Path(png)

@@ -33,17 +33,21 @@ def _study_folder(results: Path, name: str):
 
 
 def _fidelity(results: Path):
-    """benchmarks/reproduction/fidelity.py's comparison (None if the script is absent)."""
+    """benchmarks/reproduction/fidelity.py's comparison and the function writing
+    ``fidelity.json`` / ``fidelity.md`` (returning the Markdown); ({"tables": []}, None) if the
+    script is absent. The report writes them once its record holds every verdict."""
     import importlib.util
     script = REPO / "benchmarks" / "reproduction" / "fidelity.py"
     if not script.is_file():
-        return None
+        return {"tables": []}, None
     spec = importlib.util.spec_from_file_location("damage_dolfinx_fidelity", script)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    result = module.compare(results)
-    module.write(result, results / "fidelity")
-    return result
+
+    def write(result, folder):
+        module.write(result, folder)
+        return (folder / "fidelity.md").read_text()
+    return module.compare(results), write
 
 
 class Figures:

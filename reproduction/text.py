@@ -135,12 +135,15 @@ def forbidden(text: str) -> list:
 
 def self_contained_problems(folder) -> list:
     """What keeps a report folder from standing alone: forbidden words and paths in its
-    documents, and links to images that are absolute, leave the folder or are missing."""
+    documents, claims of agreement with tables the project has not, and links
+    to images that are absolute, leave the folder or are missing."""
     folder = Path(folder)
     problems = []
     for doc in sorted(folder.glob("*.html")) + sorted(folder.glob("*.md")):
         text = doc.read_text()
         problems += [f"{doc.name}: {w!r}" for w in forbidden(text)]
+        problems += [f"{doc.name}: claims what the project has not: {c!r}"
+                     for c in unsupported_claims(text)]
         links = re.findall(r'<img[^>]* src="([^"]+)"', text) + re.findall(r"!\[[^]]*\]\(([^)]+)\)", text)
         for link in links:
             target = (folder / link).resolve()
@@ -148,3 +151,35 @@ def self_contained_problems(folder) -> list:
                     or not target.is_file():
                 problems.append(f"{doc.name}: image {link!r} not inside the folder")
     return problems
+
+
+#: thesis tables this project has no values of (the thesis's copy here lacks them): nothing may
+#: claim agreement with them
+UNAVAILABLE_TABLES = ("2.1", "3.3")
+_UNAVAILABLE = re.compile(r"\bTables?\s+(?:[\d.]+\s*(?:,|and|/|-)\s*)*(?:"
+                          + "|".join(re.escape(t) for t in UNAVAILABLE_TABLES)
+                          + r")(?![\d.]*\d)")
+_AGREEMENT = re.compile(r"(?<![/\w.])(?:agree\w*|match\w*|reproduc\w*|consistent with|in line with|"
+                        r"compares? well|confirm\w*|as in|same as|close to)\b(?![/.]\w)", re.I)
+_NEGATED = re.compile(r"\b(?:not|never|no|cannot|nor|without)\b", re.I)
+#: the agreement word and the table within this many characters of each other
+_NEAR = 60
+
+
+def unsupported_claims(text: str) -> list:
+    """Passages of ``text`` that claim agreement with a thesis table the project cannot
+    compute against (UNAVAILABLE_TABLES): an agreement word and the table within _NEAR
+    characters, with no negation between them or just before the agreement word. Python's
+    implicit string concatenation across lines is joined first."""
+    text = re.sub(r"\"\s*\n\s*[fr]?\"", "", text)   # a string literal continued on the next line
+    text = re.sub(r"\s+", " ", text)
+    out = []
+    for table in _UNAVAILABLE.finditer(text):
+        lo, hi = max(0, table.start() - _NEAR), table.end() + _NEAR
+        for word in _AGREEMENT.finditer(text, lo, hi):
+            between = text[min(word.end(), table.start()):max(word.start(), table.end())]
+            before = text[max(0, word.start() - 30):word.start()]
+            if not _NEGATED.search(between) and not _NEGATED.search(before):
+                out.append(text[lo:hi].strip())
+                break
+    return out

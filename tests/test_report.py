@@ -181,7 +181,8 @@ def test_planted_departure_reaches_the_figure_verdict(tmp_path):
     from reproduction.figures import ThesisFigure
     cells = _square()
     strong = _panel(tmp_path, "strong", cells, 0.2 + 0.8 * cells[..., 1])
-    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"))
+    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
+                      subject=("stress", "damage"))
     fitted = {"what": "kappa = 0.003 instead of kappa = 1", "basis": "fitted", "fitted": True,
               "against_text": False, "source": "reading", "text": "..."}
     context = dict(run_context(_run_folder(tmp_path, "run", departures=[fitted])), T_full=1.0)
@@ -201,7 +202,8 @@ def test_planted_early_stop_is_not_comparable(tmp_path):
     from reproduction.figures import ThesisFigure
     cells = _square()
     strong = _panel(tmp_path, "strong", cells, 0.2 + 0.8 * cells[..., 1])
-    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"))
+    fig = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
+                      subject=("stress", "damage"))
     stopped = dict(run_context(_run_folder(tmp_path, "stop", "zeta_star_reached", 0.4)),
                    T_full=1.0)
     verdict = judge(fig, [strong], context=stopped)[0]
@@ -209,31 +211,105 @@ def test_planted_early_stop_is_not_comparable(tmp_path):
     cut = dict(run_context(_run_folder(tmp_path, "cut")), T_full=1.0, T_run=0.5)
     assert category(judge(fig, [strong], context=cut)[0]) == "not comparable"
     event = ThesisFigure("9.9", "9.9-ex1", "", ("a.png",), ("physical", "colocated"),
-                         event="collapse")
+                         event="collapse", subject=("stress", "damage"))
     collapse = dict(run_context(_run_folder(tmp_path, "collapse", "collapse", 0.02)), T_full=0.3)
     assert category(judge(event, [strong], context=collapse)[0]) == "reproduced"
 
 
 def test_planted_differs_whose_feature_holds(tmp_path):
-    """Figure 2.12's statement (top edge clamped, bottom edge moves) holding in the data is not
-    'differs', however large the drawn displacement; a failed check quotes our number."""
+    """Figure 2.12's statement (top edge clamped, bottom edge moves) is about the configuration
+    the thesis draws x3: a slide of a fraction of the body holds; a 16 m slide of a 4 m square
+    (x3: twelve times the body) is not that configuration and differs, quoting our numbers; a
+    moving top differs too."""
     import numpy as np
     from reproduction.checks import judge
     from reproduction.classes import category
     from reproduction.figures import THESIS_FIGURES
     fig = next(f for f in THESIS_FIGURES if f.number == "2.12")
     cells = 4 * _square()
-    disp = np.zeros_like(cells)
-    disp[..., 0] = 16.0 * (1 - cells[..., 1] / 4)             # bottom slides 16 m, top fixed
-    npz = _panel(tmp_path, "slide", cells, np.ones(cells.shape[:2]), disp=disp, amplification=3.0)
     context = {"T_full": 5.0, "status": "completed", "t_final": 5.0, "departures": []}
-    verdict = judge(fig, [npz], context=context)[0]
-    assert category(verdict) == "reproduced", verdict
-    assert "top edge 0.00, bottom edge 1.00 of max |u|" in verdict
-    disp[..., 0] = 16.0 * cells[..., 1] / 4                   # the top moves: the statement fails
+    disp = np.zeros_like(cells)
+    for slide, expected in ((0.16, "reproduced"), (16.0, "differs")):
+        disp[..., 0] = slide * (1 - cells[..., 1] / 4)      # bottom slides, top fixed
+        npz = _panel(tmp_path, f"slide{slide}", cells, np.ones(cells.shape[:2]), disp=disp,
+                     amplification=3.0)
+        verdict = judge(fig, [npz], context=context)[0]
+        assert category(verdict) == expected, verdict
+        if expected == "reproduced":
+            assert "top edge 0.00, bottom edge 1.00 of max |u|" in verdict
+    assert "x3 (the thesis's factor) gives 8.5 times its size" in verdict
+    disp[..., 0] = 0.16 * cells[..., 1] / 4                  # the top moves: the statement fails
     npz = _panel(tmp_path, "top", cells, np.ones(cells.shape[:2]), disp=disp, amplification=3.0)
     verdict = judge(fig, [npz], context=context)[0]
     assert category(verdict) == "differs" and "top edge 1.00, bottom edge 0.00" in verdict
+
+
+def test_planted_vacuous_premises_fail(tmp_path):
+    """A check counts only when its premise holds. No penetration without contact (Figure
+    3.4's beam off its foundation) fails with that reason; a damage pattern inside a body at
+    zeta* nearly everywhere (a runaway) fails with that reason; with the premise holding the
+    same data pass."""
+    import numpy as np
+    from reproduction.checks import judge, run_context
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES, ThesisFigure
+    cells = _square()
+    fig_3_4 = next(f for f in THESIS_FIGURES if f.number == "3.4")
+    npz = _panel(tmp_path, "beam", cells, np.ones(cells.shape[:2]),
+                 disp=0.01 * np.ones_like(cells), amplification=4.0)
+    for length, expected in ((0.0, "differs"), (0.4, "reproduced")):
+        folder = _run_folder(tmp_path, f"beam{length}")
+        (folder / "history.csv").write_text(
+            "step,t,u_L2,penetration_rms,contact_length\n0,0,0,0,0.5\n1,1,0.2,0,%g\n" % length)
+        context = dict(run_context(folder), T_full=1.0)
+        verdict = judge(fig_3_4, [npz], context=context)[0]
+        assert category(verdict) == expected, verdict
+    assert "premise fails: no contact at the final time" not in verdict
+    folder = _run_folder(tmp_path, "beam_off")
+    (folder / "history.csv").write_text("step,t,u_L2,penetration_rms,contact_length\n"
+                                        "0,0,0,0,0.5\n1,1,0.2,0,0\n")
+    verdict = judge(fig_3_4, [npz], context=dict(run_context(folder), T_full=1.0))[0]
+    assert "premise fails: no contact at the final time" in verdict, verdict
+    colocated = ThesisFigure("9.9", "x", "", ("a.png",), ("colocated",),
+                             subject=("stress", "damage"))
+    pattern = 0.2 + 0.8 * cells[..., 1]                     # ranks with the stress
+    assert category(judge(colocated, [_panel(tmp_path, "pattern", cells, pattern)])[0]) == \
+        "reproduced"
+    runaway = 0.01 + 0.01 * cells[..., 1]                   # at zeta* everywhere, same ranks
+    verdict = judge(colocated, [_panel(tmp_path, "runaway", cells, runaway)])[0]
+    assert category(verdict) == "differs" and "premise fails" in verdict, verdict
+    assert "a pattern inside a fully damaged body proves nothing" in verdict
+
+
+def test_statement_subjects_rule_the_checks(tmp_path):
+    """A statement about the configuration is not judged by the damage's one-colour rule
+    (Figure 2.21 with a faint damage field is reproduced, not 'not visible'); a check of another
+    subject than the statement's is refused; a 'nothing to test' beside a quoted statement is
+    refused; every quoted statement of the catalogue of figures is tested."""
+    import numpy as np
+    from reproduction.checks import judge
+    from reproduction.classes import Evidence, category, classify
+    from reproduction.figures import THESIS_FIGURES, ThesisFigure, validate
+    cells = _square()
+    fig_2_21 = next(f for f in THESIS_FIGURES if f.number == "2.21")
+    faint = _panel(tmp_path, "faint", cells, 0.95 + 0.04 * cells[..., 1],
+                   disp=0.01 * np.ones_like(cells))
+    context = {"u_L2_first": 0.0, "u_L2_last": 0.5, "u_L2_max": 1.0}
+    verdict = judge(fig_2_21, [faint], context=context)[0]
+    assert category(verdict) == "reproduced", verdict
+    wrong = ThesisFigure("9.9", "x", "", ("a.png",), ("displaced", "colocated"),
+                         quote="the configuration is not the stress-free one",
+                         subject=("configuration",))
+    with pytest.raises(ValueError, match="colocated"):
+        judge(wrong, [faint], context=context)
+    quoted = ThesisFigure("9.9", "x", "", ("a.png",), (), quote="the highest stress is central")
+    with pytest.raises(ValueError, match="quotes a statement"):
+        validate(quoted)
+    with pytest.raises(ValueError, match="refused"):
+        classify(Evidence(statement=False, quote="the highest stress is central"))
+    for fig in THESIS_FIGURES:
+        validate(fig)
+        assert not fig.quote or fig.checks or fig.kind != "field", fig.number
 
 
 def test_visibility_and_statement_rules(tmp_path):
@@ -245,7 +321,8 @@ def test_visibility_and_statement_rules(tmp_path):
     from reproduction.classes import category
     from reproduction.figures import THESIS_FIGURES, ThesisFigure
     cells = _square()
-    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"))
+    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"),
+                       subject=("stress", "damage"))
     faint = _panel(tmp_path, "faint", cells, 0.95 + 0.04 * cells[..., 1])
     verdict = judge(fig, [faint])[0]
     assert category(verdict) == "not visible in this figure" and "rank together" in verdict
@@ -303,3 +380,140 @@ def test_reader_text_and_units():
     assert forbidden(reader_text("--out /work/main/results/a/b.png", [("/work/main", "")])) == []
     assert figstyle.si_unit("von Mises stress [Pa]", 2.9e7) == ("von Mises stress [MPa]", 1e6)
     assert figstyle.si_unit("strain [-]", 2e-3) == ("strain [-]", 1.0)
+
+
+def test_one_record_per_item_planted_disagreement(tmp_path, monkeypatch):
+    """Every place that states an item's verdict prints it from one record: a second verdict
+    for an item is refused; a hand-written verdict in the readings section that differs from the
+    record stops the report; the committed readings state no verdict of their own, and the
+    report prints the record's beside each of their figure rows."""
+    from reproduction import CHECKOUT
+    from reproduction.record import VerdictRecord, stated
+    record = VerdictRecord()
+    record.set("Figure 2.12", "differs: the thesis says: x; ours: y")
+    record.set("Figure 2.12", "differs: the thesis says: x; ours: y")   # the same: fine
+    with pytest.raises(ValueError, match="two verdicts"):
+        record.set("Figure 2.12", "reproduced: x")
+    record.set("Figure 3.4", "reproduced: penetration 0 m")
+    planted = ("| figure | setting | analysis |\n|---|---|---|\n"
+               "| 2.12 / 3.4 | n = 40 | **reproduced**: the edges agree |\n\n"
+               "In one line: **3.4 differs** (the beam leaves its foundation).\n")
+    assert sorted(record.disagreements(planted)) == [
+        "text: Figure 2.12 stated as 'reproduced', the record says 'differs'",
+        "text: Figure 3.4 stated as 'differs', the record says 'reproduced'"]
+    filled = record.fill_readings(planted)
+    assert "verdict (this report) |" in filled
+    assert ("[Figure 2.12](#fig-2-12): **differs**; [Figure 3.4](#fig-3-4): **reproduced** |"
+            in filled)
+    committed = (CHECKOUT / "benchmarks" / "readings.md").read_text()
+    assert stated(committed) == []                     # no verdict of its own
+    readings = tmp_path / "readings.md"                # a report whose readings disagree
+    readings.write_text(committed + "\n| figure | analysis |\n|---|---|\n| 2.12 | "
+                        "**reproduced**: planted |\n")
+    from reproduction import build as report
+    monkeypatch.setattr(report, "READINGS", readings)
+    with pytest.raises(ValueError, match="Figure 2.12 stated as 'reproduced'"):
+        report.build(tmp_path / "results")
+    monkeypatch.setattr(report, "READINGS", CHECKOUT / "benchmarks" / "readings.md")
+    report.build(tmp_path / "results")
+    md = (tmp_path / "results" / "report" / "REPORT.md").read_text()
+    rows = {}
+    for line in md.splitlines():
+        cells = [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+        m = re.match(r"\[((?:Figure|Table) [\d.]+)\]\(#", cells[0]) if cells else None
+        if m and len(cells) == 5:
+            rows[m.group(1)] = cells[4]
+    assert len(rows) == 58
+    fidelity = (tmp_path / "results" / "fidelity" / "fidelity.md").read_text()
+    from reproduction.text import self_contained_problems
+    assert self_contained_problems(tmp_path / "results" / "report") == []
+    assert len({item for item, _ in stated(md)}) >= 50 and stated(fidelity, default_kind="Table")
+    for item, cls in stated(md) + stated(fidelity, default_kind="Table"):
+        assert rows[item].startswith(cls), (item, cls, rows[item])
+
+
+def test_no_claim_about_tables_the_project_has_not(tmp_path):
+    """No text of the product, the records or the report claims agreement with a thesis table
+    the project cannot compute against (Tables 2.1 and 3.3): every tracked text file of the
+    checkout (the tests, which plant claims, aside) and the assumptions every example prints
+    are scanned; a planted claim is found,
+    a negated mention is not."""
+    from damage_dolfinx.catalogue import examples
+    from reproduction import CHECKOUT
+    from reproduction.text import assumption, unsupported_claims
+    assert unsupported_claims('our errors "\n    "which agree with Tables 2.1 and 3.3 with the 1/2')
+    assert unsupported_claims("the rate matches Table 3.3")
+    assert unsupported_claims("Table 2.1 is reproduced within 10 %")
+    assert not unsupported_claims("our errors are never compared with Tables 2.1 and 3.3")
+    assert not unsupported_claims("python benchmarks/reproduction/x.py (Tables 2.1, 3.3)")
+    assert not unsupported_claims("convergence (Table 3.3.3) agrees")  # another number
+    files = subprocess.run(["git", "ls-files"], cwd=CHECKOUT, capture_output=True, text=True,
+                           check=True).stdout.split()
+    found = []
+    for name in files:
+        path = CHECKOUT / name
+        if path.suffix in (".png", ".pdf", ".h5", ".npz", ".xdmf") or not path.is_file() \
+                or name.startswith("tests/"):  # the tests plant claims on purpose
+            continue
+        try:
+            text = path.read_text()
+        except UnicodeDecodeError:
+            continue
+        found += [f"{name}: {c}" for c in unsupported_claims(text)]
+    for ex in examples.catalogue().values():
+        found += [f"{ex.id}: {c}" for a in ex.assumptions
+                  for c in unsupported_claims(assumption(a))]
+    assert found == [], found
+
+
+def test_contact_parts_drawn_and_setting_meshes_named():
+    """Every field figure whose thesis figure draws a contact part gets it as a guide (the
+    frictional planes, the contact part, the foundation, the obstacle), placed on the run's
+    contact boundary; a setting figure drawn on another mesh than its caption's says which."""
+    from reproduction.figures import THESIS_FIGURES, guides, mesh_drawn
+    expected = {  # our PNG: the contact part's end points (undeformed coordinates)
+        "figure_2_12_left.png": [[[0, 0], [4, 0]], [[0, 4], [4, 4]]],
+        "figure_2_13.png": [[[0, 0], [4, 0]], [[0, 4], [4, 4]]],
+        "figure_3_11.png": [[[0, 0], [4, 0]], [[0, 2], [4, 2]]],
+        "figure_3_12.png": [[[0, 0], [4, 0]], [[0, 2], [4, 2]]],
+        "figure_2_17_t0.png": [[[0, 0], [0, 1]]], "figure_2_17_t2.png": [[[0, 0], [0, 1]]],
+        "figure_2_18.png": [[[0, 0], [0, 1]]],
+        "figure_2_20_t0.png": [[[3, 0], [4, 0]]], "figure_2_20_t0.5.png": [[[3, 0], [4, 0]]],
+        "figure_2_21.png": [[[3, 0], [4, 0]]],
+        **{f"figure_3_{n}_{case}.png": [[[1, 1], [2, 1]]] for n in (7, 8)
+           for case in ("undamaged", "damaged")},
+        "figure_3_4.png": [[[0, 0], [3, 0]]], "figure_3_5.png": [[[0, 0], [3, 0]]],
+    }
+    for png, lines in expected.items():
+        drawn = [g["line"] for g in guides(png) if "line" in g]
+        assert drawn == lines and all(g.get("label") for g in guides(png)), png
+    assert guides("figure_2_14.png") == []
+    fig_2_1 = next(f for f in THESIS_FIGURES if f.number == "2.1")
+    assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --n 5 --quiet", 20) == \
+        "drawn on our mesh n = 5; the thesis's Figure 2.1 shows its mesh for n = 10"
+    assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --quiet", 20).startswith(
+        "drawn on our mesh n = 20")
+    assert mesh_drawn(fig_2_1, "damage-dolfinx run 2.1-ex1 --n 10", 20) == ""
+    fig_2_3 = next(f for f in THESIS_FIGURES if f.number == "2.3")   # no mesh in its caption
+    assert mesh_drawn(fig_2_3, "damage-dolfinx run 2.1-ex2a --n 5", 20) == ""
+
+
+def test_figure_3_21_stress_location_is_tested(tmp_path):
+    """Figure 3.21 quotes where the highest stress is ('the central region'): it is tested along
+    the body's length (its principal axis, so a slanted body is measured along itself)."""
+    import numpy as np
+    from reproduction.checks import judge
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES
+    fig = next(f for f in THESIS_FIGURES if f.number == "3.21")
+    cells = _square(8) * np.array([4.0, 0.5])                      # a bar 4 x 0.5 ...
+    c, s = np.cos(-0.8), np.sin(-0.8)
+    cells = cells @ np.array([[c, s], [-s, c]])                    # ... slanted like the wrench
+    along = (cells @ np.array([c, s]))                             # position along the bar
+    context = {"T_full": 1.0, "status": "completed", "t_final": 1.0, "departures": []}
+    for peak, expected in ((2.0, "reproduced"), (0.3, "differs")):
+        stress = 1e6 * np.exp(-(along - peak) ** 2)
+        npz = _panel(tmp_path, f"bar{peak}", cells, np.ones(cells.shape[:2]), stress=stress)
+        verdict = judge(fig, [npz], context=context)[0]
+        assert category(verdict) == expected, verdict
+    assert "% of the body's length from its middle" in verdict

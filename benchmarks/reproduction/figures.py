@@ -40,20 +40,39 @@ def restyle(out: Path, index: dict) -> int:
     return done
 
 
-def draw_guides(out: Path, index: dict) -> int:
-    """Re-render the figures that draw something beside the body (the foundation, slope and
-    obstacle planes, the arch's hinges: reproduction.figures.guides) from their panel data."""
+def _guides(npz, file):
+    """The guides of one figure (reproduction.figures.guides), with its run's summary."""
     import json
     from reproduction.figures import guides
+    summary_path = npz.parent / "summary.json" if npz else None
+    summary = (json.loads(summary_path.read_text())
+               if summary_path and summary_path.is_file() else None)
+    return guides(file, summary)
+
+
+def draw_guides(out: Path, index: dict) -> int:
+    """Re-render the figures that draw something beside the body (the frictional planes, the
+    foundations and obstacles, the arch's hinges: reproduction.figures.guides) from their panel
+    data; a figure of PAIRS keeps its group's shared scales."""
+    from damage_dolfinx.viz.figscales import is_damage, shared_limits
     done = 0
     for entry in index["figures"]:
         npz = _npz(out, index, entry)
-        summary_path = npz.parent / "summary.json" if npz else None
-        summary = json.loads(summary_path.read_text()) if summary_path and summary_path.is_file() else None
-        marks = guides(entry["file"], summary)
-        if npz and marks:
-            figstyle.render_saved(npz, out / entry["file"], guides=marks)
-            done += 1
+        marks = _guides(npz, entry["file"])
+        if not (npz and marks):
+            continue
+        limits = None
+        group = next((pair for pair in PAIRS if entry["file"] in pair), None)
+        entries = [next((f for f in index["figures"] if f["file"] == name), None)
+                   for name in group or ()]
+        npzs = [_npz(out, index, e) for e in entries]
+        if group and all(npzs):  # the scales share_pair_scales gave the group
+            loaded = [figstyle.load_panels(n)[0] for n in npzs]
+            limits = {i: shared_limits([p[i]["values"] for p in loaded])
+                      for i in range(min(len(p) for p in loaded))
+                      if not any(is_damage(p[i]["name"], p[i]["label"]) for p in loaded)}
+        figstyle.render_saved(npz, out / entry["file"], limits=limits, guides=marks)
+        done += 1
     return done
 
 
@@ -66,6 +85,29 @@ def share_pair_scales(out: Path, index: dict) -> list:
         if all(npzs):
             figstyle.render_shared(npzs, [out / name for name in pair])
             done.append(pair)
+    return done
+
+
+def stamp_settings(out: Path, index: dict, from_runs=True) -> list:
+    """Say on each setting figure which mesh it draws when the thesis's caption names another
+    (reproduction.figures.mesh_drawn); from the run's own copy (``from_runs``), so that a
+    second call does not stamp twice. Returns the files stamped."""
+    from damage_dolfinx.catalogue import examples
+    from reproduction.figures import THESIS_FIGURES, mesh_drawn
+    from reproduction.plots import note_under
+    done = []
+    for fig in THESIS_FIGURES:
+        for file in fig.files:
+            entry = next((f for f in index["figures"] if f["file"] == file), None)
+            if not entry or not (out / file).is_file():
+                continue
+            note = mesh_drawn(fig, entry.get("command", ""), examples.get(fig.example).n)
+            run = next((r for r in index["runs"] if r["example"] == entry["example"]
+                        and r["variant"] == entry["variant"]), None)
+            source = Path(run["folder"]) / entry["source"] if run and entry.get("source") else None
+            if note and (not from_runs or (source and source.is_file())):
+                note_under(out / file, note, source if from_runs else None)
+                done.append(file)
     return done
 
 
@@ -93,17 +135,21 @@ a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/figures-quick" if a.quick else "results/figures"))
 if a.settings:
-    print(f"redrawn: {' '.join(reproduce.redraw_settings(mode, out))}")
+    import json
+    print(f"redrawn: {' '.join(reproduce.redraw_settings(mode, out))}; meshes named: "
+          f"{' '.join(stamp_settings(out, json.loads((out / 'index.json').read_text()), False))}")
 if a.restyle:
     import json
     index = json.loads((out / "index.json").read_text())
     print(f"restyled {restyle(out, index)} figures in {out}; shared scales: "
-          f"{len(share_pair_scales(out, index))}; with guides: {draw_guides(out, index)}")
+          f"{len(share_pair_scales(out, index))}; with guides: {draw_guides(out, index)}; "
+          f"meshes named: {len(stamp_settings(out, index))}")
 if a.restyle or a.settings:
     raise SystemExit(0)
 index = reproduce.run_figures(mode, out, a.np, a.only, a.resume)
 shared = share_pair_scales(out, index)
 draw_guides(out, index)
+stamp_settings(out, index)
 failed = [r for r in index["runs"] if r["returncode"] != 0]
 print(f"{len(index['figures'])} figures from {len(index['runs'])} runs in "
       f"{index['wall_time_this_invocation_s']} s (runs: {index['wall_time_s']} s in two lanes) "
