@@ -141,14 +141,12 @@ def converge(problem, out, *, n=None, k=None, ref_n=None, ref_k=None, T=None, pr
     function."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
-    from damage_dolfinx.core.validation import changes, check_converge, communicator
+    from damage_dolfinx.core.validation import arguments, check_converge, communicator
     with outcome(communicator("comm", comm)):
         n, k, ref_n, ref_k, T, restart, overwrite = check_converge(
             n, k, ref_n, ref_k, T, restart, overwrite, progress, out, comm)
-        overrides = changes("overrides", overrides)
-        if reference_ranks not in (None, 1, "all"):
-            from damage_dolfinx.core.errors import InputError
-            raise InputError(f"reference_ranks must be 1, 'all' or None, got {reference_ranks!r}")
+        checked = arguments(overrides=overrides, reference_ranks=reference_ranks)
+        overrides, reference_ranks = checked["overrides"], checked["reference_ranks"]
         return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
                      progress=progress, comm=comm, restart=restart, overwrite=overwrite,
                      overrides=overrides, reference_ranks=reference_ranks)

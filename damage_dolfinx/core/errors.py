@@ -46,7 +46,15 @@ _FLAGS = ((" (problem.k_max() gives k_max before the run)", ""), ("restart=True"
 
 
 def for_command_line(message: str) -> str:
-    """A message of the API with the command line's flags for the arguments it names."""
+    """A message of the API with the command line's flags for the arguments it names: the
+    phrases of _FLAGS, and a refusal that starts with an argument's name (``k must be > 0``,
+    from the one check of that argument, core.validation) starts with its flag (``--k``)."""
+    import re
+    from damage_dolfinx.core.validation import ARGUMENTS
     for api, flag in _FLAGS:
         message = message.replace(api, flag)
+    head = re.match(r"(?:(damage-dolfinx: \w+: ))?(\w+)( must )", message)
+    if head and head.group(2) in ARGUMENTS and head.group(2) not in ("comm", "on_step"):
+        start, end = head.span(2)
+        message = message[:start] + "--" + head.group(2).replace("_", "-") + message[end:]
     return message

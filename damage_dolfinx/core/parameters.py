@@ -31,7 +31,10 @@ class ModelParameters:
     stop_at_zeta_star: bool = True  # stop when min zeta reaches zeta_star
     extra: dict = field(default_factory=dict)  # problem-specific data of later sections
 
-    def validate(self):
+    def validate(self, rules=None):
+        """The generic checks, and each extra datum by its rule (``rules``: name -> (test,
+        what it must be); default EXTRA_RULES, the data shared by several models)."""
+        rules = EXTRA_RULES if rules is None else rules
         if not (self.E > 0):
             raise InputError(f"Young modulus E must be positive, got E = {self.E}")
         if not (-1.0 < self.nu < 0.5):
@@ -53,7 +56,7 @@ class ModelParameters:
         if not (self.L_trunc > 0):
             raise InputError(f"L_trunc must be positive (inf for none), got {self.L_trunc}")
         for name, value in self.extra.items():
-            rule = EXTRA_RULES.get(name)
+            rule = rules.get(name)
             if rule is not None and not rule[0](value):
                 raise InputError(f"{name} {rule[1]}, got {name} = {value!r}")
         return self
@@ -77,47 +80,19 @@ class ModelParameters:
         return {k: (str(v) if isinstance(v, float) and math.isinf(v) else v) for k, v in d.items()}
 
 
-#: checks of the problem-specific parameters kept in ModelParameters.extra
+#: checks of the data shared by several models, kept in ModelParameters.extra; a model's own
+#: data have their rules beside it (``Model.rules``, merged along its classes by
+#: ``Model.data_rules()``), and registry.validate applies both
 EXTRA_RULES = {
     "c_nu": (lambda v: v > 0, "(normal compliance stiffness) must be positive"),
     "rho": (lambda v: v > 0, "(density) must be positive"),
     "m_visc": (lambda v: v > 0, "(viscosity divisor, A = B/m_visc) must be positive"),
-    "g_fric": (lambda v: v >= 0, "(friction bound) must be >= 0"),
-    "eps_reg": (lambda v: v > 0, "(friction regularisation) must be positive"),
-    "mu_f": (lambda v: v >= 0, "(friction coefficient) must be >= 0"),
-    "friction_solver": (lambda v: v in ("newton", "uzawa", "penalty-duality"),
-                        "must be one of newton, uzawa, penalty-duality"),
-    "rho_uzawa": (lambda v: v > 0, "(Uzawa step) must be positive"),
-    "omega_pd": (lambda v: v > 0, "(penalty-duality parameter) must be positive"),
-    "friction_tol": (lambda v: 0 < v < 1, "(relative V-change stopping test) must lie in (0, 1)"),
-    "friction_law": (lambda v: v in ("tresca", "coulomb"), "must be 'tresca' or 'coulomb'"),
-    "coulomb_normal": (lambda v: v in ("free", "bilateral"), "must be 'free' or 'bilateral'"),
-    "viscoplastic_sign": (lambda v: v in (1.0, -1.0),
-                          "(sign of the viscoplastic function G) must be 1 or -1"),
-    "memory_kernel": (lambda v: v in ("constant", "exponential"),
-                      "must be 'constant' or 'exponential'"),
-    "memory_rate": (lambda v: v >= 0, "(decay rate of the exponential kernel) must be >= 0"),
-    "memory_mode": (lambda v: v in ("auto", "running", "recursive", "sum"),
-                    "must be one of auto, running, recursive, sum"),
-    "damage_atol_rel": (lambda v: v >= 0, "(the obstacle step's absolute tolerance relative to "
-                        "||l||) must be >= 0"),
     "history_every": (lambda v: v >= 1 and v == int(v),
                       "(a history.csv row every that many steps) must be a whole number >= 1"),
     "stability_check": (lambda v: v in ("warn", "error", "off"),
                         "(explicit-term time-step check) must be warn, error or off"),
     "damage_active": (lambda v: isinstance(v, bool),
                       "(False: damage frozen at zeta_0, Section 3.1 Ex. 3) must be true or false"),
-    "error_norm": (lambda v: v in ("velocity", "displacement", "velocity_only"),
-                   "(convergence error of Section 3.1) must be velocity, displacement or "
-                   "velocity_only"),
-    "stress_in_error": (lambda v: v in ("yes", "no"),
-                        "(Section 2.4: ||sigma - sigma_hk||_Q in e_hk) must be yes or no"),
-    "elastic_term": (lambda v: v in ("explicit", "implicit"),
-                     "(Section 3.3: explicit = thesis scheme, implicit = a deviation) must be "
-                     "'explicit' or 'implicit'"),
-    "initial_damage": (lambda v: v in ("a", "b"),
-                       "(Section 3.3 Ex. 2: a = centre [2.5,3.5]^2, b = bottom [2.5,3.5]x[0,1]) "
-                       "must be 'a' or 'b'"),
 }
 
 

@@ -162,6 +162,13 @@ def seconds(name, value):
     return float(value)
 
 
+def reference_layout(name, value):
+    """Where a convergence study runs its reference: 1 (rank 0 alone), "all", or None."""
+    if value is not None and (isinstance(value, bool) or value not in (1, "all")):
+        raise InputError(f"{name} must be 1, 'all' or None, got {_shown(value)}")
+    return value
+
+
 def mesh_file_path(name, value):
     if value is None:
         return None
@@ -178,6 +185,7 @@ ARGUMENTS = {
     "checkpoint_every": _maybe(whole), "max_points": _maybe(whole),
     "h": _maybe(positive), "write_every": _maybe(whole), "history_every": _maybe(whole),
     "checkpoint_seconds": seconds, "overrides": changes, "mesh_file": mesh_file_path,
+    "reference_ranks": reference_layout,
     "plot": _maybe(text), "comm": communicator, "on_step": callback,
     "ref_n": _maybe(whole), "ref_k": _maybe(positive),
     "ranks_per_point": _maybe(whole),

@@ -99,6 +99,9 @@ class Model:
     #: the explicit update after the sub-steps, (new, old, rate): new = old + k rate
     #: (e.g. ("u", "u_old", "v"): u_n = u_{n-1} + k v_n); None: none
     update: Optional[tuple] = None
+    #: the rules of the model's own data in ``params.extra`` (name -> (test, what it must
+    #: be)); a subclass adds its own and keeps its parents' (:meth:`data_rules`)
+    rules: dict = {}
     #: quadrature degree of the contact integrals (None: estimated from the integrand); the
     #: contact resultant uses the scheme's, so that it balances the load exactly
     contact_quadrature_degree: Optional[int] = None
@@ -108,6 +111,16 @@ class Model:
     def defaults(cls) -> ModelParameters:
         """The model's default data (a generic starting point, docs/models.md)."""
         raise NotImplementedError(f"model {cls.id} declares no default data")
+
+    @classmethod
+    def data_rules(cls) -> dict:
+        """The rules of the data shared by the models (core.parameters.EXTRA_RULES) and those
+        of this model's classes, the nearest class last."""
+        from damage_dolfinx.core.parameters import EXTRA_RULES
+        merged = dict(EXTRA_RULES)
+        for klass in reversed(cls.__mro__):
+            merged.update(vars(klass).get("rules", {}))
+        return merged
 
     @classmethod
     def check(cls, params: ModelParameters) -> ModelParameters:

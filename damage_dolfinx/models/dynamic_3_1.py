@@ -70,6 +70,13 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
     old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
     update = ("u", "u_old", "v")  # (3.51) u_n = u_{n-1} + k v_n
 
+    #: the rules of the model's own data (name -> (test, what it must be))
+    rules = {
+        "error_norm": (lambda v: v in ("velocity", "displacement", "velocity_only"),
+                       "(convergence error of Section 3.1) must be velocity, displacement or "
+                       "velocity_only"),
+    }
+
     @classmethod
     def defaults(cls) -> ModelParameters:
         return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, q_star=1.0),

@@ -33,7 +33,7 @@ from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters
 from damage_dolfinx.numerics.solvers import replace_default_option
 from damage_dolfinx.numerics.stability import checked, estimate_stability
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
-from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS, FRICTION_RULES
 from damage_dolfinx.core.parameters import ModelParameters
 
 
@@ -54,6 +54,11 @@ class DynamicTresca(Model):
     history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face
     old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
     update = ("u", "u_old", "v")  # (3.96) u_n = u_{n-1} + k v_n
+
+    #: the rules of the model's own data (name -> (test, what it must be))
+    rules = {
+        **FRICTION_RULES,
+    }
 
     @classmethod
     def defaults(cls) -> ModelParameters:

@@ -90,6 +90,18 @@ class FullyDamageableContact(Model):
     old_state = (("u", "u_old"), ("v", "v_old"), ("zeta", "zeta_old"))
     update = ("u", "u_old", "v")  # (3.160) u_n = u_{n-1} + k v_n
 
+    #: the rules of the model's own data (name -> (test, what it must be))
+    rules = {
+        "damage_atol_rel": (lambda v: v >= 0, "(the obstacle step's absolute tolerance relative to "
+                            "||l||) must be >= 0"),
+        "elastic_term": (lambda v: v in ("explicit", "implicit"),
+                         "(Section 3.3: explicit = thesis scheme, implicit = a deviation) must be "
+                         "'explicit' or 'implicit'"),
+        "initial_damage": (lambda v: v in ("a", "b"),
+                           "(Section 3.3 Ex. 2: a = centre [2.5,3.5]^2, b = bottom [2.5,3.5]x[0,1]) "
+                           "must be 'a' or 'b'"),
+    }
+
     @classmethod
     def defaults(cls) -> ModelParameters:
         return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, kappa=1.0, lam_D=0.0),

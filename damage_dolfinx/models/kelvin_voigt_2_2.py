@@ -31,7 +31,7 @@ from damage_dolfinx.numerics.contact_output import near_contact
 from damage_dolfinx.forms.kelvin_voigt import kelvin_voigt_stress, velocity_step_forms
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, solver_from_parameters
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
-from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS, FRICTION_RULES
 from damage_dolfinx.core.parameters import ModelParameters
 
 
@@ -45,6 +45,11 @@ class KelvinVoigtTresca(Model):
     checkpoint_fields = ("u", "zeta", "v")
     old_state = (("u", "u_old"), ("zeta", "zeta_old"))
     update = ("u", "u_old", "v")  # (2.68) u_n = u_{n-1} + k v_n
+
+    #: the rules of the model's own data (name -> (test, what it must be))
+    rules = {
+        **FRICTION_RULES,
+    }
 
     @classmethod
     def defaults(cls) -> ModelParameters:

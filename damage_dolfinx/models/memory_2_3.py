@@ -78,6 +78,15 @@ class ViscoelasticMemoryContact(NormalComplianceScalars, Model):
     history_columns = ("penetration_rms", "stress_L2")
     old_state = (("zeta", "zeta_old"),)  # u_{n-1} stays in u until (2.137) replaces it
 
+    #: the rules of the model's own data (name -> (test, what it must be))
+    rules = {
+        "memory_kernel": (lambda v: v in ("constant", "exponential"),
+                          "must be 'constant' or 'exponential'"),
+        "memory_rate": (lambda v: v >= 0, "(decay rate of the exponential kernel) must be >= 0"),
+        "memory_mode": (lambda v: v in ("auto", "running", "recursive", "sum"),
+                        "must be one of auto, running, recursive, sum"),
+    }
+
     @classmethod
     def defaults(cls) -> ModelParameters:
         return ModelParameters(E=1e4, nu=0.3, **dict(DAMAGE_A, lam_D=1e-2, lam_u=10.0),

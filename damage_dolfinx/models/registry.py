@@ -76,8 +76,9 @@ def default_parameters(which) -> ModelParameters:
 
 def validate(which, params: ModelParameters) -> ModelParameters:
     """The generic checks of ``params`` and the model's own (``Model.check``)."""
-    params.validate()
-    return model(which).check(params)
+    cls = model(which)
+    params.validate(cls.data_rules())
+    return cls.check(params)
 
 
 def quasistatic_k_max(which, params: ModelParameters) -> float:

@@ -30,7 +30,7 @@ from damage_dolfinx.forms.viscoplastic import increment_step_forms, stress_updat
 from damage_dolfinx.numerics.friction import FrictionProblem, iteration_counters, law, solver_from_parameters
 from damage_dolfinx.numerics import bookkeeping
 from damage_dolfinx.models.base import DAMAGE_A, Model, SubStep
-from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS
+from damage_dolfinx.numerics.friction import FRICTION_DEFAULTS, FRICTION_RULES
 from damage_dolfinx.core.parameters import ModelParameters
 
 FRICTION_LAWS = ("tresca", "coulomb")
@@ -47,6 +47,17 @@ class ElastoViscoplasticFriction(Model):
     checkpoint_fields = ("u", "zeta", "w", "sigma")
     history_columns = ("stress_Q", "slip_max", "zeta_min_x", "zeta_min_y")
     old_state = (("u", "u_old"), ("sigma", "sigma_old"), ("zeta", "zeta_old"))
+
+    #: the rules of the model's own data (name -> (test, what it must be))
+    rules = {
+        **FRICTION_RULES,
+        "friction_law": (lambda v: v in ("tresca", "coulomb"), "must be 'tresca' or 'coulomb'"),
+        "coulomb_normal": (lambda v: v in ("free", "bilateral"), "must be 'free' or 'bilateral'"),
+        "viscoplastic_sign": (lambda v: v in (1.0, -1.0),
+                              "(sign of the viscoplastic function G) must be 1 or -1"),
+        "stress_in_error": (lambda v: v in ("yes", "no"),
+                            "(Section 2.4: ||sigma - sigma_hk||_Q in e_hk) must be yes or no"),
+    }
 
     @classmethod
     def defaults(cls) -> ModelParameters:

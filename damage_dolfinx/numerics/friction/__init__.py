@@ -91,6 +91,18 @@ OMEGA_PD = 100.0
 FRICTION_DEFAULTS = {"eps_reg": 1e-9, "friction_solver": "newton", "rho_uzawa": RHO_UZAWA,
                      "omega_pd": OMEGA_PD, "friction_tol": 1e-6}
 
+#: the rules of the friction data (a friction model's ``rules`` include them)
+FRICTION_RULES = {
+    "g_fric": (lambda v: v >= 0, "(friction bound) must be >= 0"),
+    "eps_reg": (lambda v: v > 0, "(friction regularisation) must be positive"),
+    "mu_f": (lambda v: v >= 0, "(friction coefficient) must be >= 0"),
+    "friction_solver": (lambda v: v in ("newton", "uzawa", "penalty-duality"),
+                        "must be one of newton, uzawa, penalty-duality"),
+    "rho_uzawa": (lambda v: v > 0, "(Uzawa step) must be positive"),
+    "omega_pd": (lambda v: v > 0, "(penalty-duality parameter) must be positive"),
+    "friction_tol": (lambda v: 0 < v < 1, "(relative V-change stopping test) must lie in (0, 1)"),
+}
+
 
 def iteration_counters(solver) -> dict:
     """The friction solver's fallback counters for summary.json (zeros for Uzawa and PD)."""
