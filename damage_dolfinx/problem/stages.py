@@ -52,10 +52,7 @@ def configure(ex, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None
         raise InputError(f"example {ex.id} uses a structured mesh: set it with --n, not --h")
     n = ex.n if n is None else int(n)
     h = ex.h if h is None else float(h)
-    if n is not None and n < 1:
-        raise InputError(f"number of cells per side n must be >= 1, got n = {n}")
-    if h is not None and not h > 0:
-        raise InputError(f"mesh size h must be positive, got h = {h}")
+    # n >= 1 and h > 0 were checked by the entry point (core.validation, by their names)
     if mesh_file is not None and not Path(mesh_file).is_file():
         from damage_dolfinx.core.validation import mesh_path_problem
         raise InputError(f"mesh file {str(mesh_file)!r} "
