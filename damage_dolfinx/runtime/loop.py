@@ -150,6 +150,8 @@ class Run(RunRecords):
                                       mesh_file, self.configured), "cannot set up the solvers")
         except ConvergenceError as exc:
             raise InputError(str(exc)) from None
+        from damage_dolfinx.models.contracts import check as check_contracts
+        check_contracts(self.stepper)  # its declarations against what it built (ContractError)
         ContactOutput.for_model(self.stepper)  # contact quantities in history.csv and XDMF
 
     def _check_checkpoints(self):
