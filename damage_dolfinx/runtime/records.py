@@ -4,6 +4,7 @@ XDMF fields, checkpoints, figures, the per-step collective checks and the interr
 from __future__ import annotations
 
 import signal
+import sys
 import time
 
 import numpy as np
@@ -117,11 +118,28 @@ class RunRecords:
         self.write_summary()
 
     def figure(self, fig, suffix=""):
+        """Draw one figure. A figure that cannot be drawn is a figure failure, not the
+        computation's: it is listed in the summary (``outputs.figure_failures``) and on stderr,
+        and the run goes on with its status (collective: every rank agrees)."""
+        filename = fig.filename.replace(".png", f"{suffix}.png")
+
         def draw():
-            add_to_manifest(self.out, [fig.filename.replace(".png", f"{suffix}.png")], self.comm)
-            self.summary["outputs"]["figures"].append(
-                draw_figure(self.ex, fig, self.stepper, self.out, suffix))
-        io.collective(self.comm, self.out, self.at(fig.filename), draw)
+            add_to_manifest(self.out, [filename], self.comm)
+            try:
+                entry = draw_figure(self.ex, fig, self.stepper, self.out, suffix)
+            except (OSError, RuntimeError):
+                raise
+            except Exception as exc:  # noqa: BLE001 - any drawing error: the figure's
+                raise RuntimeError(f"{type(exc).__name__}: {exc}") from exc
+            self.summary["outputs"]["figures"].append(entry)
+        try:
+            io.collective(self.comm, self.out, self.at(filename), draw)
+        except io.OutputError as exc:
+            self.summary["outputs"].setdefault("figure_failures", []).append(
+                {"file": filename, "error": str(exc)})
+            if self.comm.rank == 0:
+                print(f"damage-dolfinx: figure not drawn (the computation is not affected): "
+                      f"{exc}", file=sys.stderr, flush=True)
 
     def timed_figures(self):
         """Figures requested at the current time (Figure.times)."""
