@@ -53,6 +53,8 @@ class RegularisedNewton:
     a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9)."""
 
     name = "newton"
+    #: its solve evaluates a bound of the state itself (make_solver wraps other solvers)
+    refreshes_bound = True
 
     def __init__(self, problem: FrictionProblem, eps_reg=1e-9, prefix="friction_",
                  continuation=(1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)):
@@ -331,6 +333,7 @@ class RegularisedNewton:
         start = time.perf_counter()
         before = self.snes.iterations + self.pdas_iterations
         self.eps.value = self.target
+        self.nodes.refresh_bound()  # a bound of the state: evaluated now (nodes.py)
         if self.algebraic:
             self.residual.assemble_rhs()
         try:
