@@ -62,8 +62,11 @@ class RegularisedNewton:
         self.p, self.target = problem, float(eps_reg)
         self.continuation = [e for e in continuation if e > self.target] + [self.target]
         self.eps = fem.Constant(msh, self.target)
-        w, ds = ufl.TestFunction(problem.V), problem.nodal_ds()
-        dv = ufl.TrialFunction(problem.V)
+        # the test and trial functions of the problem's own forms (not new ones: a form that
+        # mixes two Arguments of the same number is refused by UFL, so a solver built again
+        # from the same FrictionProblem must not bring its own)
+        w, dv = sorted(problem.a.arguments(), key=lambda arg: arg.number())
+        ds = problem.nodal_ds()
         self.v0 = fem.Function(problem.V)
         self.shift = fem.Constant(msh, 0.0)
         F, shift_term, friction_change = self._friction_forms(problem, w, dv)
