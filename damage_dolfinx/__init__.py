@@ -30,7 +30,8 @@ __version__ = "0.1.0"
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
            "Model", "SubStep", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
-           "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run"]
+           "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run",
+           "check_model"]
 
 _WHERE = {"Problem": "problem", "run": "workflow", "steps": "workflow", "Model": "models.base",
           "SubStep": "models.base", "converge": "workflow",
@@ -38,7 +39,7 @@ _WHERE = {"Problem": "problem", "run": "workflow", "steps": "workflow", "Model":
           "THESIS_B": "laws", "read_mesh": "meshes", "from_gmsh": "meshes",
           "ModelParameters": "parameters", "InputError": "parameters", "read_run": "results",
           "ConvergenceError": "numerics.solvers", "OutputError": "runtime.atomic",
-          "RunInterrupted": "runtime.signals"}
+          "RunInterrupted": "runtime.signals", "check_model": "model_check"}
 
 
 def __getattr__(name):

@@ -96,53 +96,76 @@ def _solver_prefix(solve):
 
 def check(model):
     """Raise ContractError naming the first declaration the built ``model`` breaks."""
-    mid = model.id
+    found = problems(model)
+    if found:
+        raise ContractError(found[0][1])
+
+
+def problems(model) -> list:
+    """(check, message) for each declaration the built ``model`` breaks, check one of
+    ``declarations``, ``previous_state``, ``checkpoint``, ``prefixes``, ``stability_limit``."""
+    mid, found = model.id, []
     pairs = []
     for pair in model.old_state:
         if not (isinstance(pair, tuple) and len(pair) == 2):
-            raise ContractError(f"model {mid}: old_state holds {pair!r}, not a (Function, copy) "
-                                "pair of attribute names")
-        pairs.append(tuple(_function(model, name, "old_state") for name in pair))
+            found.append(("declarations", f"model {mid}: old_state holds {pair!r}, not a "
+                          "(Function, copy) pair of attribute names"))
+            continue
+        try:
+            pairs.append((pair[0], *(_function(model, name, "old_state") for name in pair)))
+        except ContractError as exc:
+            found.append(("declarations", str(exc)))
     if model.update is not None:
         if len(model.update) != 3:
-            raise ContractError(f"model {mid}: update is {model.update!r}, not (new, old, rate)")
-        for name in model.update:
-            _function(model, name, "update")
+            found.append(("declarations", f"model {mid}: update is {model.update!r}, not "
+                          "(new, old, rate)"))
+        else:
+            for name in model.update:
+                try:
+                    _function(model, name, "update")
+                except ContractError as exc:
+                    found.append(("declarations", str(exc)))
     # what the package's blocks read from the previous step is declared
-    declared = {(id(a), id(b)) for a, b in pairs}
+    declared = {(id(a), id(b)) for _, a, b in pairs}
+
+    def name_of(f):
+        return next((k for k, v in vars(model).items() if v is f), f.name)
     for attr, value in list(vars(model).items()):
         for new, old in getattr(value, "previous_state", ()) or ():
             if (id(new), id(old)) not in declared:
-                name = lambda f: next((k for k, v in vars(model).items() if v is f), f.name)  # noqa: E731
-                raise ContractError(
-                    f"model {mid}: its {type(value).__name__} ({attr}) reads "
-                    f"{name(old)} = {name(new)} of the previous step, but old_state does not "
-                    f"copy it: add ({name(new)!r}, {name(old)!r}) to old_state")
+                found.append(("previous_state",
+                              f"model {mid}: its {type(value).__name__} ({attr}) reads "
+                              f"{name_of(old)} = {name_of(new)} of the previous step, but "
+                              f"old_state does not copy it: add ({name_of(new)!r}, "
+                              f"{name_of(old)!r}) to old_state"))
     # what a step reads from the previous one is in the checkpoint
-    if getattr(model, "checkpoint_supported", True):
-        saved = checkpoint_functions(model)
-        if saved:
-            ids = {id(f) for f in saved.values()}
-            for (name, _), (new, _) in zip(model.old_state, pairs):
-                if id(new) not in ids:
-                    raise ContractError(
-                        f"model {mid}: the step starts from {name!r} of the previous step "
-                        f"(old_state) but its checkpoint ({', '.join(saved) or 'nothing'}) does "
-                        f"not hold it: a restart would start from a wrong {name!r}; add it to "
-                        "checkpoint_fields or to what checkpoint_state() returns")
+    saved = checkpoint_functions(model)
+    if saved:
+        ids = {id(f) for f in saved.values()}
+        for name, new, _ in pairs:
+            if id(new) not in ids:
+                found.append(("checkpoint",
+                              f"model {mid}: the step starts from {name!r} of the previous step "
+                              f"(old_state) but its checkpoint ({', '.join(saved) or 'nothing'}) "
+                              f"does not hold it: a restart would start from a wrong {name!r}; "
+                              "add it to checkpoint_fields or to what checkpoint_state() returns"))
     # the declared prefix of each sub-step is its solver's
     for step in model.scheme():
         if step.solve is None:
             continue
         used = _solver_prefix(step.solve)
         if used is not None and used != step.prefix:
-            raise ContractError(
-                f"model {mid}: sub-step {step.name!r} declares the PETSc prefix "
-                f"{step.prefix!r}, but its solver uses {used!r} (-{step.prefix}... options "
-                f"would not reach it): declare prefix={used!r}")
+            found.append(("prefixes",
+                          f"model {mid}: sub-step {step.name!r} declares the PETSc prefix "
+                          f"{step.prefix!r}, but its solver uses {used!r} (-{step.prefix}... "
+                          f"options would not reach it): declare prefix={used!r}"))
     # the mesh-dependent stability limit, where the model gives it
     if model.dynamic and type(model).mesh_k_max is not _base_mesh_k_max():
-        mesh_k_max(model)
+        try:
+            mesh_k_max(model)
+        except ContractError as exc:
+            found.append(("stability_limit", str(exc)))
+    return found
 
 
 def _base_mesh_k_max():
