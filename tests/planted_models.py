@@ -129,3 +129,38 @@ PLANTED = {
     "update_names_nothing": variant("update_names_nothing", update=("u", "u_old", "w")),
     "dynamic_without_limit": variant("dynamic_without_limit", dynamic=True),
 }
+
+
+class _HiddenOldState(Compliant):
+    """Reads theta_old, copied by itself (begin_step) and not declared: its checkpoint misses
+    theta, which no declaration shows (the restart check sees it)."""
+    old_state = (("u", "u_old"), ("zeta", "zeta_old"))
+    checkpoint_fields = ("u", "zeta", "v")
+
+    def begin_step(self):
+        self.theta_old.x.array[:] = self.theta.x.array
+
+
+class _RankDependent(Compliant):
+    """theta depends on the rank count (a value of rank 0 only, not reduced)."""
+
+    def _heat(self):
+        super()._heat()
+        self.theta.x.array[:] += 0.01 * self.comm.size
+        return None
+
+
+PLANTED.update({
+    "hidden_old_state": type("hidden_old_state", (_HiddenOldState,),
+                             {"id": "test-hidden_old_state", "__module__": __name__}),
+    "scalar_without_column": variant("scalar_without_column", history_columns=()),
+    "rank_dependent": type("rank_dependent", (_RankDependent,),
+                           {"id": "test-rank_dependent", "__module__": __name__}),
+})
+
+#: the check of dd.check_model each planted mistake fails
+FAILS = {"nan_in_own_field": "run", "override_drops_field": "contracts",
+         "old_state_without_zeta": "contracts", "old_state_without_u": "contracts",
+         "wrong_prefix": "prefixes", "update_names_nothing": "contracts",
+         "dynamic_without_limit": "stability_limit", "hidden_old_state": "restart",
+         "scalar_without_column": "history_columns", "rank_dependent": "serial_vs_2_ranks"}
