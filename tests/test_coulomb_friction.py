@@ -43,3 +43,55 @@ def test_a_bound_of_the_friction_unknown_is_refused():
                                 b.SolveContext())
     with pytest.raises(dd.InputError, match="depends on the friction unknown 'v'"):
         b.friction_solver("newton", problem, 1e-9, 1.0, 100.0)
+
+
+def _friction(g_of):
+    import ufl
+    from dolfinx import fem
+    from mpi4py import MPI
+    from damage_dolfinx import blocks as b
+    geometry = DEMO["block"](MPI.COMM_WORLD, 1)
+    V = b.vector_p1(geometry.mesh)
+    v = fem.Function(V, name="v")
+    dv, w = ufl.TrialFunction(V), ufl.TestFunction(V)
+    ds = ufl.Measure("ds", domain=geometry.mesh, subdomain_data=geometry.facet_tags)
+    g = g_of(geometry.mesh)
+    problem = b.FrictionProblem(v, ufl.dot(dv, w) * ufl.dx + ufl.inner(b.eps(dv), b.eps(w)) * ufl.dx,
+                                ufl.dot(ufl.as_vector((1.0, 0.0)), w) * ufl.dx, [], g, ds(3),
+                                b.SolveContext())
+    return g, b.friction_solver("newton", problem, 1e-9, 1.0, 100.0)
+
+
+def test_a_bound_of_x_and_fixed_constants_is_evaluated_once():
+    from dolfinx import fem
+    import ufl
+    g, solver = _friction(lambda msh: fem.Constant(msh, 0.5) * (1 + ufl.SpatialCoordinate(msh)[0]))
+    solver.solve()
+    solver.solve()
+    assert solver.nodes.bound_refreshes == 0      # the thesis models' per-step path
+
+
+def test_a_constant_bound_that_changes_is_evaluated_again():
+    from dolfinx import fem
+    g, solver = _friction(lambda msh: fem.Constant(msh, 0.5))
+    solver.solve()
+    assert solver.nodes.bound_refreshes == 0
+    g.value = 2.0
+    solver.solve()
+    assert solver.nodes.bound_refreshes == 1
+    assert abs(solver.nodes.g - 2.0).max() < 1e-12
+
+
+def test_a_matrix_assembled_once_may_not_hold_the_state():
+    import ufl
+    from dolfinx import fem
+    from mpi4py import MPI
+    from damage_dolfinx import blocks as b
+    geometry = DEMO["block"](MPI.COMM_WORLD, 1)
+    Z = b.scalar_p1(geometry.mesh)
+    zeta = fem.Function(Z, name="zeta")
+    u, w = ufl.TrialFunction(Z), ufl.TestFunction(Z)
+    with pytest.raises(dd.InputError, match="holds the Function"):
+        b.LinearSolver((1 + zeta) * u * w * ufl.dx, w * ufl.dx, [], "test_", b.SolveContext(),
+                       constant_matrix=True)
+    b.LinearSolver((1 + zeta) * u * w * ufl.dx, w * ufl.dx, [], "test_", b.SolveContext())
