@@ -59,3 +59,11 @@ def test_a_dynamic_model_gives_its_limit_through_mesh_k_max():
     bad = type("bad", (cls,), {"id": "test-bad", "mesh_k_max": lambda self: "0.1"})
     with pytest.raises(ContractError, match="not a positive number"):
         pm.problem(bad).k_max()
+
+
+def test_a_field_of_its_own_leaving_its_declared_bounds_fails_the_run(tmp_path):
+    bounded = pm.variant("bounded", state_bounds={"theta": (0.0, 0.15)})  # theta = t (2 - zeta)
+    with pytest.raises(dd.ConvergenceError, match=r"theta left its bounds \[0, 0.15\]"):
+        run(bounded, tmp_path / "bounded")
+    assert run(pm.variant("wide", state_bounds={"theta": (0.0, 1.0)}),
+               tmp_path / "wide")["status"] == "completed"

@@ -94,6 +94,9 @@ class Model:
     checkpoint_fields: tuple = ("u", "zeta")
     #: the scalars this model adds to history.csv
     history_columns: tuple = ()
+    #: bounds of fields of its own, {attribute: (lo, hi)} (e.g. an adhesion field in [0, 1]):
+    #: the state check after every step stops the run when one is left by more than 1e-6
+    state_bounds: dict = {}
     #: the old state a step starts from: (Function, its copy) attribute pairs, copied first
     old_state: tuple = (("u", "u_old"), ("zeta", "zeta_old"))
     #: the explicit update after the sub-steps, (new, old, rate): new = old + k rate

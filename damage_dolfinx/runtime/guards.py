@@ -72,10 +72,14 @@ def state_views(stepper) -> list:
     if views is None:
         from damage_dolfinx.models.contracts import state_functions
         views = []
+        bounds = {id(getattr(stepper, name, None)): (name, lo, hi)
+                  for name, (lo, hi) in (getattr(stepper, "state_bounds", None) or {}).items()}
         for name, f in state_functions(stepper):
             V = f.function_space
+            is_zeta = f is getattr(stepper, "zeta", None)
             views.append((name, f.x.array[:V.dofmap.index_map.size_local
-                                          * V.dofmap.index_map_bs], f is getattr(stepper, "zeta", None)))
+                                          * V.dofmap.index_map_bs],
+                          True if is_zeta else bounds.get(id(f), False)))
         try:
             stepper._state_views = views
         except AttributeError:  # a stepper without a __dict__: looked up each time
@@ -92,12 +96,17 @@ def state_problem(stepper, tolerance=None):
     if tolerance is None:
         bounded = getattr(getattr(stepper, "damage", None), "obstacle", True)
         tolerance = STATE_TOLERANCE if bounded else PDE_STATE_MARGIN
-    for name, values, is_zeta in state_views(stepper):
-        if is_zeta and values.size:  # min and max propagate a NaN: no third pass
+    for name, values, bounded in state_views(stepper):
+        if bounded and values.size:  # min and max propagate a NaN: no third pass
             lo, hi = float(values.min()), float(values.max())
             if not (np.isfinite(lo) and np.isfinite(hi)):
                 return 1, f"{name} is not finite (NaN or Inf)"
-            if lo < zeta_star - tolerance or hi > 1.0 + tolerance:
+            if bounded is not True:  # a field of the model's own with its state_bounds
+                _, low, high = bounded
+                if lo < low - STATE_TOLERANCE or hi > high + STATE_TOLERANCE:
+                    return 2, (f"{name} left its bounds [{low:g}, {high:g}] (state_bounds) by "
+                               f"more than {STATE_TOLERANCE:g}: min {lo:.6g}, max {hi:.10g}")
+            elif lo < zeta_star - tolerance or hi > 1.0 + tolerance:
                 return 2, (f"zeta left [zeta_star, 1] = [{zeta_star:g}, 1] by more than "
                            f"{tolerance:g}: min {lo:.6g}, max {hi:.10g}")
         elif values.size and not np.isfinite(values).all():
