@@ -97,8 +97,7 @@ class CoulombKelvinVoigt(dd.Model):
         self._k_max = b.estimate_k_max(V, p.E, p.nu, rho, x["m_visc"], x["c_nu"], self.dsC,
                                        normal=self.nu)
         self._momentum = fem.form(rho * self.v[0] * ufl.dx)
-        self._normal = fem.form(b.normal_compliance_pressure(self.u, self.nu, x["c_nu"],
-                                                             self.gap) * self.dsC)
+        self._normal = fem.form(self.contact_pressure() * self.dsC)
         Q = b.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
         sigma = b.kelvin_voigt_stress(self.v, self.u, self.zeta, p.E, p.nu, x["m_visc"],
@@ -108,6 +107,10 @@ class CoulombKelvinVoigt(dd.Model):
 
     def mesh_k_max(self):
         return self._k_max
+
+    def contact_pressure(self):
+        x = self.params.extra
+        return b.normal_compliance_pressure(self.u, self.nu, x["c_nu"], self.gap)
 
     def scheme(self):
         return (dd.SubStep("damage", "snes-vi", "damage_", self.damage.solve, ("damage_its",)),
