@@ -26,7 +26,7 @@ def test_a_figure_that_fails_leaves_the_run_completed(tmp_path, monkeypatch, cap
     assert on_disk["status"] == "completed"
     failures = on_disk["outputs"]["figure_failures"]
     assert failures and "cannot reshape" in failures[0]["error"]
-    assert "figure not drawn" in capsys.readouterr().err
+    assert "not drawn at step" in capsys.readouterr().err
 
 
 def quad_block(comm, n):
