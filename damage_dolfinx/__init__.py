@@ -30,7 +30,8 @@ from damage_dolfinx.core.version import __version__  # noqa: F401
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
            "Model", "SubStep", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
-           "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run"]
+           "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run",
+           "check_model"]
 
 _WHERE = {"Problem": "problem.problem", "run": "api.workflow", "steps": "api.workflow",
           "Model": "models.base", "SubStep": "models.base", "converge": "api.workflow",
@@ -39,7 +40,7 @@ _WHERE = {"Problem": "problem.problem", "run": "api.workflow", "steps": "api.wor
           "from_gmsh": "problem.meshes", "ModelParameters": "core.parameters",
           "InputError": "core.errors", "read_run": "api.results",
           "ConvergenceError": "core.errors", "OutputError": "core.errors",
-          "RunInterrupted": "core.errors"}
+          "RunInterrupted": "core.errors", "check_model": "api.model_check"}
 
 
 def __getattr__(name):

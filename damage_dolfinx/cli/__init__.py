@@ -116,5 +116,5 @@ def _main(argv, comm, given):
 
 def _say(comm, text):
     if comm.rank == 0:
-        from damage_dolfinx.core.errors import for_command_line
+        from damage_dolfinx.cli.wording import for_command_line
         print(for_command_line(text), file=sys.stderr, flush=True)

@@ -94,6 +94,9 @@ class Model:
     checkpoint_fields: tuple = ("u", "zeta")
     #: the scalars this model adds to history.csv
     history_columns: tuple = ()
+    #: bounds of fields of its own, {attribute: (lo, hi)} (e.g. an adhesion field in [0, 1]):
+    #: the state check after every step stops the run when one is left by more than 1e-6
+    state_bounds: dict = {}
     #: the old state a step starts from: (Function, its copy) attribute pairs, copied first
     old_state: tuple = (("u", "u_old"), ("zeta", "zeta_old"))
     #: the explicit update after the sub-steps, (new, old, rate): new = old + k rate
@@ -132,6 +135,24 @@ class Model:
         """The closed-form stability limit of a quasistatic scheme with an explicit term
         (inf: none, or mesh-dependent, checked when the model is built)."""
         return math.inf
+
+    def mesh_k_max(self) -> Optional[float]:
+        """The stability limit of k on this model's mesh with its data (a dynamic scheme's
+        explicit terms), computed in the constructor (e.g. with ``blocks.estimate_k_max``);
+        None: no limit. ``Problem.k_max()`` builds the model and returns it (inf for None);
+        ``dd.check_model`` compares it with an eigenvalue estimate. The package's dynamic models
+        keep it in ``self.stability["k_max"]`` (3.1, 3.3) or an instance ``k_max`` (3.2), read
+        here; a model of your own overrides this method."""
+        stability = getattr(self, "stability", None)
+        if isinstance(stability, dict):
+            return stability.get("k_max")
+        if "k_max" in vars(self):  # an instance attribute, not the classmethod
+            return vars(self)["k_max"]
+        if self.dynamic:
+            raise NotImplementedError(
+                f"model {self.id} is dynamic (its stability limit depends on the mesh) but does "
+                "not give it: implement mesh_k_max(self) (a number, or None: no limit)")
+        return None
 
     @classmethod
     def boundary_roles(cls) -> dict:
@@ -197,9 +218,13 @@ class Model:
     checkpoint_supported = True
 
     def checkpoint_state(self) -> dict:
-        """name -> Function: everything the next step reads, as ``checkpoint_fields``
-        declares. Models with more state extend this."""
-        return {name: getattr(self, name) for name in self.checkpoint_fields}
+        """name -> Function: everything the next step reads: ``checkpoint_fields``, and the
+        Function of each ``old_state`` pair (what the next step starts from) by construction,
+        also when ``checkpoint_fields`` leaves it out. Models with more state extend this (and
+        are refused when they leave an ``old_state`` Function out: models/contracts.py)."""
+        names = list(self.checkpoint_fields)
+        names += [new for new, _ in self.old_state if new not in names]
+        return {name: getattr(self, name) for name in names}
 
     def restore(self, n: int):
         """Continue from time level n after checkpoint.load() has set checkpoint_state()."""
@@ -299,10 +324,13 @@ class Model:
         from damage_dolfinx.numerics.damage import DamageStep
         p, msh = self.params, self.mesh
         phi_old = self.damage_source(eps(self.u_old), self.zeta_old)
-        return DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.data.time.k),
+        step = DamageStep(self.zeta, self.zeta_old, phi_old, fem.Constant(msh, self.data.time.k),
                           fem.Constant(msh, float(p.kappa)), self.context, obstacle=True,
                           zeta_star=p.zeta_star, prefix=prefix,
                           irreversible=self.data.irreversible)
+        # the explicit source reads u_{n-1}: u_old must be the copy of u (contracts.py)
+        step.previous_state = step.previous_state + ((self.u, self.u_old),)
+        return step
 
     def damage_source(self, e, z):
         """The damage source phi(e, z) of this run: the user's law, or the thesis law (1.3) or

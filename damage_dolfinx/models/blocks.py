@@ -20,7 +20,10 @@ Contact laws:
     :func:`normal_compliance_term` (its boundary integral); :func:`bilateral` (u.nu = 0 on
     faces parallel to coordinate planes, a component Dirichlet condition); Tresca friction
     j(w) = int g abs(w_tau) through :class:`FrictionProblem` and a friction solver;
-    :func:`coulomb_bound` the simplified Coulomb bound mu_f abs(S_n) (a Tresca bound g).
+    :func:`coulomb_bound` the simplified Coulomb bound mu_f abs(S_n) (a Tresca bound g);
+    :func:`coulomb_friction_bound` Coulomb friction with normal compliance, the bound
+    g = mu p_nu(u_{n-1}) of the previous step's displacement (a bound of the state: the friction
+    solver evaluates it at the start of every solve).
 Friction solvers (second-kind inequalities, prefix ``friction_``):
     :class:`RegularisedNewton` (Newton on the regularised law Phi_eps), :func:`friction_solver`
     (a solver by name: ``newton``, or a registered alternative), :data:`FRICTION_DEFAULTS`.
@@ -60,7 +63,7 @@ from damage_dolfinx.numerics.stability import check_time_step, estimate_k_max
 __all__ = ["B", "ConvergenceError", "DamageLaw", "DamageStep", "FRICTION_DEFAULTS",
            "FrictionProblem", "LinearSolver", "MemoryKernel", "MemoryTerm", "NonlinearSolver",
            "OMEGA_PD", "Phi_L", "RHO_UZAWA", "RegularisedNewton", "SolveContext", "bilateral",
-           "check_time_step", "clamped", "coulomb_bound", "damaged_elastic_stress", "eps",
+           "check_time_step", "clamped", "coulomb_bound", "coulomb_friction_bound", "damaged_elastic_stress", "eps",
            "estimate_k_max", "eta_star", "expression", "interpolate", "scalar_dg0", "scalar_p1",
            "tensor_dg0", "vector_p1", "friction_solver", "kelvin_voigt_stress", "load",
            "memory_stress", "normal_compliance_pressure", "normal_compliance_term",
@@ -71,3 +74,13 @@ def coulomb_bound(mu_f, S_n):
     """The simplified Coulomb friction bound g = mu_f abs(S_n) for a prescribed normal stress S_n
     (Section 2.4, P2): Tresca friction with this bound."""
     return mu_f * abs(S_n)
+
+
+def coulomb_friction_bound(mu, u_old, normal, c_nu, gap=0.0):
+    """The Coulomb friction bound g = mu p_nu(u_old) = mu c_nu (u_old . nu - gap)_+ of normal
+    compliance, for :class:`FrictionProblem`: ``u_old`` is the previous step's displacement (a
+    Function the step copies in ``old_state``), so the bound is explicit in time and the friction
+    solve keeps its Jacobian (g does not depend on its unknown). The solver evaluates it at the
+    contact nodes at the start of every solve (a bound of the friction unknown itself is
+    refused). Used by ``demos/demo_coulomb_friction.py``."""
+    return mu * normal_compliance_pressure(u_old, normal, c_nu, gap)

@@ -81,6 +81,9 @@ class DamageStep:
         a, L = damage_step_forms(ufl.TrialFunction(V), ufl.TestFunction(V), zeta_old, phi_old,
                                  k, kappa)
         self.zeta, self.zeta_old, self.obstacle = zeta, zeta_old, obstacle or irreversible
+        #: (new, old) pairs read from the previous step: old must be the copy of new made at
+        #: the start of the step (a model's old_state; models/contracts.py checks it)
+        self.previous_state = ((zeta, zeta_old),)
         # irreversibility: zeta_n <= zeta_{n-1} as the upper bound of the obstacle step; the PDE
         # step (1.5) then becomes the obstacle problem over {zeta <= zeta_{n-1}} (no lower bound)
         self.irreversible = irreversible

@@ -132,6 +132,22 @@ def lagged_direct(comm) -> dict:
     return serial_cholesky(comm, LAGGED_DIRECT)
 
 
+def _refuse_frozen(form, prefix, what):
+    """A matrix assembled once may not hold Functions (the state): it would be frozen at their
+    values when the solver is built (InputError, before any step)."""
+    import ufl
+    from dolfinx import fem
+    from damage_dolfinx.core.parameters import InputError
+    if not isinstance(form, ufl.Form):
+        return
+    held = [c for c in form.coefficients() if isinstance(c, fem.Function)]
+    if held:
+        raise InputError(f"the matrix of the {prefix!r} solver is assembled once ({what}) but "
+                         f"holds the Function(s) {', '.join(sorted({f.name for f in held}))}: "
+                         "it would stay at their values when the solver was built; pass "
+                         "constant_matrix=False (assembled at every solve)")
+
+
 class LinearSolver:
     """Solve a(u, w) = L(w) with Dirichlet conditions by a PETSc KSP.
 
@@ -155,6 +171,10 @@ class LinearSolver:
 
     def __init__(self, a, L, bcs, prefix: str, context: SolveContext, constant_matrix=False,
                  defaults=None, refactor_after_its=None, rhs_product=None, block_matrix=False):
+        if constant_matrix:
+            _refuse_frozen(a, prefix, "constant_matrix=True")
+        if rhs_product is not None:
+            _refuse_frozen(rhs_product[0], prefix, "rhs_product")
         self.a, self.L, self.bcs = compat.form(a), compat.form(L), list(bcs)
         self._product = None
         if rhs_product is not None:

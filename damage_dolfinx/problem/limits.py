@@ -32,6 +32,5 @@ def k_max(problem, comm=MPI.COMM_WORLD) -> float:
     from damage_dolfinx.numerics.stability_bound import exact_estimates
     with exact_estimates():  # the eigensolved limit, not only the cheap bound below it
         stepper = ex.build(comm, ex.n, small, T)
-    value = getattr(stepper, "stability", {}).get("k_max") if isinstance(
-        getattr(stepper, "stability", None), dict) else getattr(stepper, "k_max", None)
-    return float(value) if value is not None else math.inf
+    from damage_dolfinx.models.contracts import mesh_k_max
+    return mesh_k_max(stepper)  # Model.mesh_k_max, checked (inf: no limit)

@@ -64,28 +64,51 @@ def solver_step(fn, where):
                                ) from exc
 
 
+def state_views(stepper) -> list:
+    """(name, owned values) of every Function the model holds as state (models/contracts.py
+    ``state_functions``: u, zeta, what it checkpoints, both sides of ``old_state``, ``update``,
+    its output fields), looked up once (the value arrays are views that stay valid)."""
+    views = getattr(stepper, "_state_views", None)
+    if views is None:
+        from damage_dolfinx.models.contracts import state_functions
+        views = []
+        bounds = {id(getattr(stepper, name, None)): (name, lo, hi)
+                  for name, (lo, hi) in (getattr(stepper, "state_bounds", None) or {}).items()}
+        for name, f in state_functions(stepper):
+            V = f.function_space
+            is_zeta = f is getattr(stepper, "zeta", None)
+            views.append((name, f.x.array[:V.dofmap.index_map.size_local
+                                          * V.dofmap.index_map_bs],
+                          True if is_zeta else bounds.get(id(f), False)))
+        try:
+            stepper._state_views = views
+        except AttributeError:  # a stepper without a __dict__: looked up each time
+            pass
+    return views
+
+
 def state_problem(stepper, tolerance=None):
-    """What is wrong with the stepper's owned values (NaN/Inf in u or zeta, zeta outside
-    [zeta_star - tol, 1 + tol]; tol STATE_TOLERANCE, or PDE_STATE_MARGIN for a damage step in
-    PDE form) on this rank, as (code, detail): code 0 (fine), 1 (non-finite), 2 (zeta out of
-    range). Owned arrays, NumPy only."""
+    """What is wrong with the stepper's owned values (NaN/Inf in any Function it holds as
+    state, :func:`state_views`; zeta outside [zeta_star - tol, 1 + tol]; tol STATE_TOLERANCE,
+    or PDE_STATE_MARGIN for a damage step in PDE form) on this rank, as (code, detail): code 0
+    (fine), 1 (non-finite), 2 (zeta out of range). Owned arrays, NumPy only."""
     zeta_star = stepper.params.zeta_star
     if tolerance is None:
         bounded = getattr(getattr(stepper, "damage", None), "obstacle", True)
         tolerance = STATE_TOLERANCE if bounded else PDE_STATE_MARGIN
-    for name in ("u", "zeta"):
-        f = getattr(stepper, name, None)
-        if f is None:
-            continue
-        V = f.function_space
-        values = f.x.array[:V.dofmap.index_map.size_local * V.dofmap.index_map_bs]
-        if name == "zeta" and values.size:  # min and max propagate a NaN: no third pass
+    for name, values, bounded in state_views(stepper):
+        if bounded and values.size:  # min and max propagate a NaN: no third pass
             lo, hi = float(values.min()), float(values.max())
             if not (np.isfinite(lo) and np.isfinite(hi)):
                 return 1, f"{name} is not finite (NaN or Inf)"
-            if lo < zeta_star - tolerance or hi > 1.0 + tolerance:
+            if bounded is not True:  # a field of the model's own with its state_bounds
+                _, low, high = bounded
+                if lo < low - STATE_TOLERANCE or hi > high + STATE_TOLERANCE:
+                    return 2, (f"{name} left its bounds [{low:g}, {high:g}] (state_bounds) by "
+                               f"more than {STATE_TOLERANCE:g}: min {lo:.6g}, max {hi:.10g}")
+            elif lo < zeta_star - tolerance or hi > 1.0 + tolerance:
                 return 2, (f"zeta left [zeta_star, 1] = [{zeta_star:g}, 1] by more than "
                            f"{tolerance:g}: min {lo:.6g}, max {hi:.10g}")
-        elif not np.isfinite(values).all():
+        elif values.size and not np.isfinite(values).all():
             return 1, f"{name} is not finite (NaN or Inf)"
     return 0, ""

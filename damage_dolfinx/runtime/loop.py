@@ -122,6 +122,7 @@ class Run(RunRecords):
                       "output time (the run was killed while writing it)", file=sys.stderr,
                       flush=True)
         self._build_model(mesh_file)
+        self._check_drawable()
         self.settings["fingerprint"] = checkpoint.verify_fingerprint(self.ex, self.stepper,
                                                                      self.resume, self.out)
         claim_folder(*claim)
@@ -139,7 +140,24 @@ class Run(RunRecords):
                                       mesh_file, self.configured), "cannot set up the solvers")
         except ConvergenceError as exc:
             raise InputError(str(exc)) from None
+        from damage_dolfinx.models.contracts import check as check_contracts
+        check_contracts(self.stepper)  # its declarations against what it built (ContractError)
         ContactOutput.for_model(self.stepper)  # contact quantities in history.csv and XDMF
+
+    def _check_drawable(self):
+        """The figures draw simplex meshes (triangles, tetrahedra): a run of a quadrilateral
+        or hexahedral mesh with figures is refused here, before any step (not after it)."""
+        if not (self.options["figures"] and self.ex.figures):
+            return
+        topology = self.stepper.mesh.topology
+        cell = getattr(topology, "cell_type", None)
+        if cell is None:  # DOLFINx with mixed topologies: cell_types
+            cell = topology.cell_types[0]
+        name = getattr(cell, "name", str(cell))
+        if name not in ("triangle", "tetrahedron", "interval"):
+            raise InputError(f"the figures draw triangle and tetrahedron meshes, this mesh has "
+                             f"{name} cells: run it with figures=False (--no-figures), or on "
+                             "a simplex mesh")
 
     def _check_checkpoints(self):
         stepper, o = self.stepper, self.options

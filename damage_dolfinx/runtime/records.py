@@ -4,6 +4,7 @@ XDMF fields, checkpoints, figures, the per-step collective checks and the interr
 from __future__ import annotations
 
 import signal
+import sys
 import time
 
 import numpy as np
@@ -117,11 +118,37 @@ class RunRecords:
         self.write_summary()
 
     def figure(self, fig, suffix=""):
+        """Draw one figure. A figure whose drawing fails (an error of the drawing, not of the
+        disk) is a figure failure, not the computation's: it is listed in the summary
+        (``outputs.figure_failures``) and on stderr, and the run goes on with its status. A
+        file that cannot be written (full disk, I/O error) stays an output error of the run
+        (io.collective). Every rank agrees on both."""
+        filename = fig.filename.replace(".png", f"{suffix}.png")
+        failure = []
+
         def draw():
-            add_to_manifest(self.out, [fig.filename.replace(".png", f"{suffix}.png")], self.comm)
-            self.summary["outputs"]["figures"].append(
-                draw_figure(self.ex, fig, self.stepper, self.out, suffix))
-        io.collective(self.comm, self.out, self.at(fig.filename), draw)
+            add_to_manifest(self.out, [filename], self.comm)
+            try:
+                entry = draw_figure(self.ex, fig, self.stepper, self.out, suffix)
+            except OSError:
+                raise
+            except Exception as exc:  # noqa: BLE001 - any drawing error: the figure's
+                failure.append(f"{type(exc).__name__}: {exc}")
+                return
+            self.summary["outputs"]["figures"].append(entry)
+        io.collective(self.comm, self.out, self.at(filename), draw)
+        failures = [f for f in self.comm.allgather(failure[0] if failure else None) if f]
+        if failures:
+            if not failure:  # another rank failed to draw: this rank's entry is not kept
+                entries = self.summary["outputs"]["figures"]
+                if entries and entries[-1].get("file") == filename:
+                    entries.pop()
+            self.summary["outputs"].setdefault("figure_failures", []).append(
+                {"file": filename, "error": failures[0]})
+            if self.comm.rank == 0:
+                print(f"damage-dolfinx: figure {filename} not drawn at step {self.stepper.n} "
+                      f"(the computation is not affected): {failures[0]}", file=sys.stderr,
+                      flush=True)
 
     def timed_figures(self):
         """Figures requested at the current time (Figure.times)."""

@@ -135,4 +135,20 @@ def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: 
         raise InputError(f"unknown friction solver {kind!r}; choose one of {', '.join(SOLVERS)}"
                          " (the reproduction's uzawa and penalty-duality are registered by "
                          "importing reproduction.baselines from the checkout)")
-    return SOLVERS[kind](problem, eps_reg, rho_uzawa, omega_pd, tol)
+    solver = SOLVERS[kind](problem, eps_reg, rho_uzawa, omega_pd, tol)
+    nodes = getattr(solver, "nodes", None)
+    if hasattr(nodes, "refresh_bound") and not getattr(solver, "refreshes_bound", False):
+        solve = solver.solve
+
+        def solve_with_current_bound(*args, **kwargs):  # a bound of the state: evaluated now
+            nodes.refresh_bound()
+            return solve(*args, **kwargs)
+        solver.solve = solve_with_current_bound
+    elif nodes is None:
+        from ufl.algorithms.analysis import extract_coefficients
+        from dolfinx import fem
+        if any(isinstance(c, fem.Function) for c in extract_coefficients(problem.g)):
+            raise InputError(f"the {kind} friction solver cannot evaluate a friction bound that "
+                             "depends on the state (it holds no contact nodes to update): use "
+                             "the newton solver")
+    return solver

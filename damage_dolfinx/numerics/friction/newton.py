@@ -53,6 +53,8 @@ class RegularisedNewton:
     a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9)."""
 
     name = "newton"
+    #: its solve evaluates a bound of the state itself (make_solver wraps other solvers)
+    refreshes_bound = True
 
     def __init__(self, problem: FrictionProblem, eps_reg=1e-9, prefix="friction_",
                  continuation=(1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)):
@@ -60,8 +62,11 @@ class RegularisedNewton:
         self.p, self.target = problem, float(eps_reg)
         self.continuation = [e for e in continuation if e > self.target] + [self.target]
         self.eps = fem.Constant(msh, self.target)
-        w, ds = ufl.TestFunction(problem.V), problem.nodal_ds()
-        dv = ufl.TrialFunction(problem.V)
+        # the test and trial functions of the problem's own forms (not new ones: a form that
+        # mixes two Arguments of the same number is refused by UFL, so a solver built again
+        # from the same FrictionProblem must not bring its own)
+        w, dv = sorted(problem.a.arguments(), key=lambda arg: arg.number())
+        ds = problem.nodal_ds()
         self.v0 = fem.Function(problem.V)
         self.shift = fem.Constant(msh, 0.0)
         F, shift_term, friction_change = self._friction_forms(problem, w, dv)
@@ -331,6 +336,7 @@ class RegularisedNewton:
         start = time.perf_counter()
         before = self.snes.iterations + self.pdas_iterations
         self.eps.value = self.target
+        self.nodes.refresh_bound()  # a bound of the state: evaluated now (nodes.py)
         if self.algebraic:
             self.residual.assemble_rhs()
         try:

@@ -113,7 +113,8 @@ class ContactNodes:
         ds = problem.nodal_ds()
         n_owned = S.dofmap.index_map.size_local
         m = _assembled(phi * ds)[:n_owned]
-        gm = _assembled(problem.g * phi * ds)[:n_owned]
+        self._bound_setup(problem, phi, ds, n_owned)
+        gm = _assembled(self._g_form)[:n_owned]
         self.dofs = np.flatnonzero(m > 0)
         if not np.allclose(S.tabulate_dof_coordinates()[self.dofs],
                            V.tabulate_dof_coordinates()[self.dofs]):
@@ -121,6 +122,43 @@ class ContactNodes:
         self.m = m[self.dofs]
         self.g = gm[self.dofs] / self.m
         return w, ds, n_owned
+
+    def _bound_setup(self, problem, phi, ds, n_owned):
+        """The friction bound g may be any UFL scalar: of x (fixed), of Constants (e.g. the
+        time), or of Functions of the state (Coulomb: mu p_nu(u_{n-1})). It is evaluated at
+        the nodes when the solver is built and again at the start of each solve where it can
+        have changed (:meth:`refresh_bound`: Functions in it, or a Constant whose value
+        changed). A bound of the friction unknown itself is refused: the solvers hold g fixed
+        during a solve (their Jacobian has no dg/dv)."""
+        from ufl.algorithms.analysis import extract_coefficients, extract_type
+        g = problem.g
+        functions = [c for c in extract_coefficients(g) if isinstance(c, fem.Function)]
+        if any(f is problem.v for f in functions):
+            raise InputError("the friction bound g depends on the friction unknown "
+                             f"{problem.v.name!r} itself: the friction solvers hold g fixed "
+                             "during a solve; write it from the previous step's state (e.g. "
+                             "mu p_nu(u_old), blocks.coulomb_friction_bound)")
+        self._g_form = compat.form(g * phi * ds)
+        self._g_functions = functions
+        self._g_constants = [c for c in extract_type(g, ufl.Constant) if hasattr(c, "value")]
+        self._g_values = [np.asarray(c.value).tobytes() for c in self._g_constants]
+        self._n_owned = n_owned
+        #: True: g is refreshed before every solve (it holds Functions)
+        self.variable_bound = bool(functions)
+        self.bound_refreshes = 0
+
+    def refresh_bound(self) -> bool:
+        """Evaluate g at the nodes again (in place: every solver sees the new g) if it can have
+        changed since the last evaluation; True if it was evaluated. A bound of x and fixed
+        Constants (the thesis models) is never evaluated again."""
+        if not self.variable_bound and all(np.asarray(c.value).tobytes() == v for c, v in
+                                           zip(self._g_constants, self._g_values)):
+            return False  # (a bytes comparison: under a microsecond per Constant)
+        gm = _assembled(self._g_form)[:self._n_owned]
+        self.g[:] = gm[self.dofs] / self.m
+        self._g_values = [np.asarray(c.value).tobytes() for c in self._g_constants]
+        self.bound_refreshes += 1
+        return True
 
     @property
     def dim(self) -> int:
@@ -180,8 +218,9 @@ def near_nullspace(V):
 
 
 def _assembled(L) -> np.ndarray:
-    """Local array (owned + ghost values summed across ranks) of an assembled linear form."""
-    f = compat.form(L)
+    """Local array (owned + ghost values summed across ranks) of an assembled linear form
+    (UFL, or already compiled)."""
+    f = L if not isinstance(L, ufl.Form) else compat.form(L)
     b = compat.create_vector(f)
     with b.localForm() as bl:
         bl.set(0.0)

@@ -1,0 +1,188 @@
+"""The contracts between a model's declarations and what it builds, checked when the model is
+built (before any step), for the package's models and for a model of your own alike.
+
+* every name of ``old_state`` and ``update`` is a Function of the built model;
+* what a step reads from the previous one is in the checkpoint: each Function ``new`` of an
+  ``old_state`` pair (its value at the end of step n is what step n+1 starts from) is among
+  :meth:`Model.checkpoint_state` (the base class adds it by construction; a model that
+  overrides ``checkpoint_state`` and leaves one out is refused);
+* the state a package block reads from the previous step is declared: a block holding
+  ``previous_state`` (the damage step: (zeta, zeta_old), and (u, u_old) for the explicit
+  source of ``obstacle_damage_step``) needs each of its (new, old) pairs in ``old_state``;
+* the PETSc prefix of each :class:`SubStep` is that of the solver its ``solve`` calls, where
+  the solver can be seen (a bound ``solve`` of a package solver, or a ``partial`` of one);
+* a dynamic model gives its mesh-dependent stability limit through :meth:`Model.mesh_k_max`
+  (a positive number, or None: none).
+
+:func:`state_functions` is the list of Functions the run checks after every step (finite, and
+zeta within its bounds): everything a model holds as state, from its declarations.
+"""
+from __future__ import annotations
+
+import functools
+import math
+
+from dolfinx import fem
+
+from damage_dolfinx.core.parameters import InputError
+
+
+class ContractError(InputError):
+    """A model's declarations disagree with what it builds (refused before any step)."""
+
+
+def _function(model, name, what):
+    f = getattr(model, name, None)
+    if not isinstance(f, fem.Function):
+        raise ContractError(f"model {model.id}: {what} names {name!r}, which is "
+                            f"{'not set' if f is None else 'not a dolfinx Function'} on the "
+                            "built model (create it in __init__)")
+    return f
+
+
+def checkpoint_functions(model) -> dict:
+    """name -> Function of the checkpoint (the NumPy solver state left out); {} when the model
+    has no checkpoints."""
+    if not getattr(model, "checkpoint_supported", True):
+        return {}
+    try:
+        state = model.checkpoint_state()
+    except InputError:  # a variant without checkpoints (2.3 memory_mode=sum)
+        return {}
+    return {name: f for name, f in state.items() if isinstance(f, fem.Function)}
+
+
+def state_functions(model) -> list:
+    """(name, Function) of everything the model holds as state, each Function once: u and
+    zeta, what it checkpoints, both sides of ``old_state``, the names of ``update``, and its
+    ``output_fields``."""
+    seen, out = set(), []
+
+    def add(name, f):
+        if isinstance(f, fem.Function) and id(f) not in seen:
+            seen.add(id(f))
+            out.append((name, f))
+    for name in ("u", "zeta"):
+        add(name, getattr(model, name, None))
+    for name, f in checkpoint_functions(model).items():
+        add(name, f)
+    for pair in model.old_state:
+        for name in pair:
+            add(name, getattr(model, name, None))
+    for name in model.update or ():
+        add(name, getattr(model, name, None))
+    for f in getattr(model, "output_fields", ()) or ():
+        add(getattr(f, "name", "output"), f)
+    return out
+
+
+def _solver_prefix(solve):
+    """The PETSc prefix of the package solver a sub-step's ``solve`` calls (None: not seen)."""
+    while isinstance(solve, functools.partial):
+        solve = solve.func
+    owner = getattr(solve, "__self__", None)
+    if owner is None:
+        return None
+    from damage_dolfinx.models.base import Model
+    if isinstance(owner, Model):  # a method of the model: its solvers are not seen
+        return None
+    for holder in (owner, getattr(owner, "snes", None), getattr(owner, "linear", None),
+                   getattr(owner, "newton", None)):
+        prefix = getattr(holder, "prefix", None)
+        if isinstance(prefix, str):
+            return prefix
+    return None
+
+
+def check(model):
+    """Raise ContractError naming the first declaration the built ``model`` breaks."""
+    found = problems(model)
+    if found:
+        raise ContractError(found[0][1])
+
+
+def problems(model) -> list:
+    """(check, message) for each declaration the built ``model`` breaks, check one of
+    ``declarations``, ``previous_state``, ``checkpoint``, ``prefixes``, ``stability_limit``."""
+    mid, found = model.id, []
+    pairs = []
+    for pair in model.old_state:
+        if not (isinstance(pair, tuple) and len(pair) == 2):
+            found.append(("declarations", f"model {mid}: old_state holds {pair!r}, not a "
+                          "(Function, copy) pair of attribute names"))
+            continue
+        try:
+            pairs.append((pair[0], *(_function(model, name, "old_state") for name in pair)))
+        except ContractError as exc:
+            found.append(("declarations", str(exc)))
+    if model.update is not None:
+        if len(model.update) != 3:
+            found.append(("declarations", f"model {mid}: update is {model.update!r}, not "
+                          "(new, old, rate)"))
+        else:
+            for name in model.update:
+                try:
+                    _function(model, name, "update")
+                except ContractError as exc:
+                    found.append(("declarations", str(exc)))
+    # what the package's blocks read from the previous step is declared
+    declared = {(id(a), id(b)) for _, a, b in pairs}
+
+    def name_of(f):
+        return next((k for k, v in vars(model).items() if v is f), f.name)
+    for attr, value in list(vars(model).items()):
+        for new, old in getattr(value, "previous_state", ()) or ():
+            if (id(new), id(old)) not in declared:
+                found.append(("previous_state",
+                              f"model {mid}: its {type(value).__name__} ({attr}) reads "
+                              f"{name_of(old)} = {name_of(new)} of the previous step, but "
+                              f"old_state does not copy it: add ({name_of(new)!r}, "
+                              f"{name_of(old)!r}) to old_state"))
+    # what a step reads from the previous one is in the checkpoint
+    saved = checkpoint_functions(model)
+    if saved:
+        ids = {id(f) for f in saved.values()}
+        for name, new, _ in pairs:
+            if id(new) not in ids:
+                found.append(("checkpoint",
+                              f"model {mid}: the step starts from {name!r} of the previous step "
+                              f"(old_state) but its checkpoint ({', '.join(saved) or 'nothing'}) "
+                              f"does not hold it: a restart would start from a wrong {name!r}; "
+                              "add it to checkpoint_fields or to what checkpoint_state() returns"))
+    # the declared prefix of each sub-step is its solver's
+    for step in model.scheme():
+        if step.solve is None:
+            continue
+        used = _solver_prefix(step.solve)
+        if used is not None and used != step.prefix:
+            found.append(("prefixes",
+                          f"model {mid}: sub-step {step.name!r} declares the PETSc prefix "
+                          f"{step.prefix!r}, but its solver uses {used!r} (-{step.prefix}... "
+                          f"options would not reach it): declare prefix={used!r}"))
+    # the mesh-dependent stability limit, where the model gives it
+    if model.dynamic and type(model).mesh_k_max is not _base_mesh_k_max():
+        try:
+            mesh_k_max(model)
+        except ContractError as exc:
+            found.append(("stability_limit", str(exc)))
+    return found
+
+
+def _base_mesh_k_max():
+    from damage_dolfinx.models.base import Model
+    return Model.mesh_k_max
+
+
+def mesh_k_max(model) -> float:
+    """The built model's mesh-dependent stability limit (:meth:`Model.mesh_k_max`), checked:
+    a positive number or inf (None from the model: no limit)."""
+    try:
+        value = model.mesh_k_max()
+    except NotImplementedError as exc:
+        raise ContractError(str(exc)) from None
+    if value is None:
+        return math.inf
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0:
+        raise ContractError(f"model {model.id}: mesh_k_max() returned {value!r}, not a positive "
+                            "number (None: no limit)")
+    return float(value)

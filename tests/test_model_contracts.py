@@ -1,0 +1,69 @@
+"""A model's declarations are checked against what it builds (models/contracts.py), and the
+state check after every step covers every Function it holds as state: each planted mistake of
+tests/planted_models.py is refused before any step, or stops the run as failed, with a message
+naming what to fix; the correct model runs."""
+import json
+
+import numpy as np
+import pytest
+
+import damage_dolfinx as dd
+import planted_models as pm
+from damage_dolfinx.models.contracts import ContractError
+
+
+def run(cls, out, **kw):
+    return dd.run(pm.problem(cls, **kw.pop("problem", {})), str(out), progress=False,
+                  figures=False, **kw)
+
+
+def test_the_correct_model_runs(tmp_path):
+    assert run(pm.Compliant, tmp_path / "ok")["status"] == "completed"
+
+
+def test_a_nan_in_a_field_of_its_own_fails_the_run(tmp_path):
+    with pytest.raises(dd.ConvergenceError, match="theta is not finite"):
+        run(pm.PLANTED["nan_in_own_field"], tmp_path / "nan")
+    assert json.loads((tmp_path / "nan" / "summary.json").read_text())["status"] == "failed"
+
+
+def test_what_the_step_starts_from_is_checkpointed_by_construction(tmp_path):
+    cls = pm.PLANTED["field_not_checkpointed"]
+    whole = run(cls, tmp_path / "whole")
+    run(cls, tmp_path / "half", problem=dict(T=0.1), checkpoint_every=1)
+    resumed = run(cls, tmp_path / "half", restart=True)
+    assert whole["status"] == resumed["status"] == "completed"
+    a, b = (np.load(tmp_path / f / "fields_final.npz") for f in ("whole", "half"))
+    assert np.array_equal(a["theta"], b["theta"]) and np.array_equal(a["zeta"], b["zeta"])
+
+
+@pytest.mark.parametrize("name, message", [
+    ("override_drops_field", "starts from 'theta' of the previous step"),
+    ("old_state_without_zeta", r"add \('zeta', 'zeta_old'\) to old_state"),
+    ("old_state_without_u", r"add \('u', 'u_old'\) to old_state"),
+    ("wrong_prefix", "declares the PETSc prefix 'velocity_', but its solver uses 'mech_'"),
+    ("update_names_nothing", "update names 'w'"),
+])
+def test_a_broken_declaration_is_refused_before_any_step(tmp_path, name, message):
+    with pytest.raises(ContractError, match=message):
+        run(pm.PLANTED[name], tmp_path / name)
+    assert not (tmp_path / name / "history.csv").exists()
+
+
+def test_a_dynamic_model_gives_its_limit_through_mesh_k_max():
+    cls = pm.PLANTED["dynamic_without_limit"]
+    with pytest.raises(ContractError, match="implement mesh_k_max"):
+        pm.problem(cls).k_max()
+    given = type("given", (cls,), {"id": "test-given", "mesh_k_max": lambda self: 0.125})
+    assert pm.problem(given).k_max() == 0.125
+    bad = type("bad", (cls,), {"id": "test-bad", "mesh_k_max": lambda self: "0.1"})
+    with pytest.raises(ContractError, match="not a positive number"):
+        pm.problem(bad).k_max()
+
+
+def test_a_field_of_its_own_leaving_its_declared_bounds_fails_the_run(tmp_path):
+    bounded = pm.variant("bounded", state_bounds={"theta": (0.0, 0.15)})  # theta = t (2 - zeta)
+    with pytest.raises(dd.ConvergenceError, match=r"theta left its bounds \[0, 0.15\]"):
+        run(bounded, tmp_path / "bounded")
+    assert run(pm.variant("wide", state_bounds={"theta": (0.0, 1.0)}),
+               tmp_path / "wide")["status"] == "completed"
