@@ -114,3 +114,8 @@ def test_the_variant_reuses_its_parent_and_copies_nothing():
     assert own <= {"id", "title", "contact_roles", "defaults", "with_roles", "increment_step",
                    "_compliance", "contact_pressure", "iteration_totals"}
     assert issubclass(ElastoViscoplasticCompliance, ElastoViscoplasticFriction)
+
+
+def test_the_variant_passes_the_model_self_test(tmp_path):
+    report = dd.check_model(problem("2.4-nc"), out=tmp_path, mpi=False)
+    assert report.ok, str(report)
