@@ -1,8 +1,27 @@
 """Running problems: :func:`run` one problem into a run folder, :func:`converge` a problem
-against a fine reference, :func:`gather` a field onto rank 0 (any number of ranks)."""
+against a fine reference, :func:`gather` a field onto rank 0 (any number of ranks).
+
+``petsc_options`` (all four calls): PETSc options of the package's solvers for this call only,
+``{"mech_ksp_type": "cg", "damage_snes_monitor": None}`` (names with or without the dash,
+values str/number/bool, None for a flag), checked as the command line checks its own: a name
+outside the solver prefixes (``mech_``, ``damage_``, ``friction_``, ``uzawa_``, ``pd_``,
+``stability_``) or a value PETSc refuses raises InputError before any work, an option no solver
+read is warned about (UserWarning) at the end, and the options database is as before after the
+call. A script's own command line: ``petsc_options=dd.petsc_options_from_argv()``."""
 from __future__ import annotations
 
+import os
+from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
+
 from mpi4py import MPI
+
+from damage_dolfinx.problem import Problem  # (light: no DOLFINx, for the annotations)
+from damage_dolfinx.runtime.steps import Steps
+
+#: what a run is given: a Problem, or the id of a catalogue or registered example
+ProblemLike = Union["Problem", str]
+PathLike = Union[str, "os.PathLike[str]"]
+PetscOptions = Optional[Mapping[str, Any]]
 
 
 def _named(problem):
@@ -13,9 +32,17 @@ def _named(problem):
     return problem
 
 
-def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD,
-        on_step=None) -> dict:
+def _petsc(petsc_options, comm, what):
+    from damage_dolfinx.cli.petsc_options import scoped
+    return scoped(petsc_options, comm, what)
+
+
+def run(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
+        k: Optional[float] = None, T: Optional[float] = None, restart: bool = False,
+        overwrite: bool = False, checkpoint_every: Optional[int] = None, progress: bool = True,
+        figures: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+        on_step: Optional[Callable[[Any], Any]] = None,
+        petsc_options: PetscOptions = None) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
     ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
     ``out/summary.json``).
@@ -32,6 +59,7 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     ``on_step(step)``: called after the initial state and after every step with the
     :class:`~damage_dolfinx.runtime.runner.Step` (see :func:`steps`); a true return value stops
     the run there (status "stopped", with its outputs and a checkpoint: ``restart`` continues).
+    ``petsc_options``: PETSc options of this run's solvers (the module's docstring).
 
     Raises (all importable from ``damage_dolfinx``; damage_dolfinx.errors):
 
@@ -55,13 +83,17 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
                                                                  "overwrite"))
         checkpoint_every, progress, figures = (checked[key] for key in (
             "checkpoint_every", "progress", "figures"))
-        return _run(_named(problem), out, n=n, k=k, T=T, restart=restart, overwrite=overwrite,
-                    checkpoint_every=checkpoint_every, progress=progress, figures=figures,
-                    comm=comm, on_step=on_step)
+        with _petsc(petsc_options, comm, "run"):
+            return _run(_named(problem), out, n=n, k=k, T=T, restart=restart,
+                        overwrite=overwrite, checkpoint_every=checkpoint_every,
+                        progress=progress, figures=figures, comm=comm, on_step=on_step)
 
 
-def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD):
+def steps(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
+          k: Optional[float] = None, T: Optional[float] = None, restart: bool = False,
+          overwrite: bool = False, checkpoint_every: Optional[int] = None,
+          progress: bool = True, figures: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+          petsc_options: PetscOptions = None) -> "Steps":
     """The run of :func:`run` (the same arguments, the same run folder), step by step::
 
         with dd.steps(problem, "results/mine") as run:
@@ -99,14 +131,34 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
         n, k, T, restart, overwrite, checkpoint_every, progress, figures = (
             checked[key] for key in ("n", "k", "T", "restart", "overwrite", "checkpoint_every",
                                      "progress", "figures"))
-        run = Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
-                          overwrite=overwrite, checkpoint_every=checkpoint_every,
-                          progress=progress, figures=figures, comm=comm)
-    return Steps(run, comm)
+        scope = _petsc(petsc_options, comm, "run")
+        scope.__enter__()  # left when the steps end (_within)
+        try:
+            run = Run.prepare(_named(problem), out, n=n, k=k, T=T, restart=restart,
+                              overwrite=overwrite, checkpoint_every=checkpoint_every,
+                              progress=progress, figures=figures, comm=comm)
+        except BaseException:
+            scope._restore()
+            raise
+    return Steps(run, comm, within=lambda steps: _within(steps, scope))
 
 
-def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart=False,
-             overwrite=True, comm=MPI.COMM_WORLD) -> dict:
+def _within(steps: Iterator, scope) -> Iterator:
+    """The steps with the run's PETSc options in force until they end: the unread ones are
+    warned about when the run goes to its end (a loop left early, or an exception, only
+    restores the options database: no collective call there)."""
+    try:
+        yield from steps
+    except BaseException:
+        scope._restore()
+        raise
+    scope.__exit__(None, None, None)
+
+
+def converge(problem: ProblemLike, out: PathLike, *, n: Sequence[int], k: Sequence[float],
+             ref_n: int, ref_k: float, T: Optional[float] = None, progress: bool = True,
+             restart: bool = False, overwrite: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+             petsc_options: PetscOptions = None) -> dict:
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
     run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
     and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
@@ -121,18 +173,20 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart
     holding a study: nothing to do when it completed with these settings, else it runs again
     (studies keep no checkpoints); a study whose settings or run fingerprint at any level (mesh,
     loads, law, ... as a run's restart checks) differ is refused, naming what changed.
-    ``overwrite=False`` refuses a folder that holds a study."""
+    ``overwrite=False`` refuses a folder that holds a study. ``petsc_options``: PETSc options of
+    every run of the study (the module's docstring)."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
     from damage_dolfinx.validation import check_converge, communicator
     with outcome(communicator("comm", comm)):
         n, k, ref_n, ref_k, T, restart, overwrite = check_converge(
             n, k, ref_n, ref_k, T, restart, overwrite, progress, out, comm)
-        return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
-                     progress=progress, comm=comm, restart=restart, overwrite=overwrite)
+        with _petsc(petsc_options, comm, "convergence study"):
+            return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
+                         progress=progress, comm=comm, restart=restart, overwrite=overwrite)
 
 
-def gather(function):
+def gather(function: Any) -> "Optional[tuple[Any, Any]]":
     """``(coords, values)`` of a P1 or DG0 ``dolfinx.fem.Function`` on rank 0, all ranks'
     owned dofs in a rank-independent order (sorted by coordinates), so that a serial run and a
     parallel one compare entry by entry; ``None`` on the other ranks (collective)."""
@@ -140,14 +194,27 @@ def gather(function):
     return gather_dof_field(function)
 
 
-def sweep(problem, out, grid, **kwargs) -> dict:
+def sweep(problem: ProblemLike, out: PathLike, grid: Mapping[str, Sequence[Any]], *,
+          n: Optional[int] = None, k: Optional[float] = None, T: Optional[float] = None,
+          restart: bool = False, max_points: Optional[int] = None, plot: str = "zeta_min",
+          figures: bool = True, progress: bool = True, ranks_per_point: Optional[int] = None,
+          point: Optional[int] = None, comm: MPI.Comm = MPI.COMM_WORLD,
+          petsc_options: PetscOptions = None) -> dict:
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.sweep import sweep as _sweep
-    return _sweep(_named(problem), out, grid, **kwargs)
+    from damage_dolfinx.validation import communicator
+    with outcome(communicator("comm", comm)):
+        scope = _petsc(petsc_options, comm, "sweep")
+    with scope:
+        return _sweep(_named(problem), out, grid, n=n, k=k, T=T, restart=restart,
+                      max_points=max_points, plot=plot, figures=figures, progress=progress,
+                      ranks_per_point=ranks_per_point, point=point, comm=comm)
 
 
 def _sweep_doc():
     from damage_dolfinx.studies.sweep import sweep as _sweep  # light: no DOLFINx import
-    return _sweep.__doc__
+    return _sweep.__doc__ + """
+    ``petsc_options``: PETSc options of every point's run (this module's docstring)."""
 
 
 sweep.__doc__ = _sweep_doc()

@@ -59,7 +59,7 @@ step damage-dolfinx --version
 LINES_SHOWN=6 step damage-dolfinx -h
 LINES_SHOWN=4 step damage-dolfinx list
 LINES_SHOWN=20 step damage-dolfinx show 2.1-ex1
-step damage-dolfinx run 2.1-ex1 --n 4 --T 0.05 --no-figures --quiet --out run-ex1
+step damage-dolfinx run 2.1-ex1 --n 5 --T 0.05 --no-figures --quiet --out run-ex1
 test -f run-ex1/summary.json
 
 # the README's own-problem example, as the README writes it (T shortened)

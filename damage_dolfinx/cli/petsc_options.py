@@ -1,7 +1,10 @@
-"""PETSc options on the command line: single-dash words reach the package's solvers (prefixes
-PETSC_PREFIXES); any other single-dash word is refused with the double-dash option it
-resembles, a value PETSc refuses is refused before any work, and an option no solver read is
-named in a warning at the end."""
+"""PETSc options of the command line and of the API (``petsc_options=`` of ``run``, ``steps``,
+``converge``, ``sweep``; :func:`petsc_options_from_argv` for a script's own command line),
+checked alike, each check in one place: a name outside the package's solver prefixes
+(PETSC_PREFIXES, :func:`_check_name`) is refused (the command line suggests the double-dash
+option it resembles), a value PETSc refuses is refused before any work
+(:func:`_check_petsc_values`), and an option no solver read is named in a warning at the end
+(:func:`_unused`). The API's options hold for the one call only (:func:`scoped`)."""
 from __future__ import annotations
 
 import argparse
@@ -36,16 +39,141 @@ def _petsc_options(tokens, parser, command):
         if not tok.startswith("-") or len(tok) == 1 or not _is_option(tok):
             raise InputError(f"unrecognised argument {tok!r}")
         name = tok[1:]
-        if not (name.startswith(PETSC_PREFIXES) or name in PETSC_GLOBAL):
-            hint = _suggestion("--" + name, parser, command)
-            raise InputError(f"unknown option {tok}: not a PETSc option of this program's "
-                             f"solvers (prefixes {', '.join(PETSC_PREFIXES)}){hint}")
+        _check_name(name, lambda: _suggestion("--" + name, parser, command))
         given[name] = value if value is not None else ""
         i += 2 if value is not None else 1
     opts = PETSc.Options()
     for name, value in given.items():
         opts[name] = value
     return given
+
+
+def _check_name(name, hint=lambda: ""):
+    """A PETSc option name (without its dash) of the package's solvers, or InputError; ``hint``
+    gives what to add to the message (the command line: the double-dash option it resembles)."""
+    from damage_dolfinx.parameters import InputError
+    if not isinstance(name, str) or not name:
+        raise InputError(f"a PETSc option name is a non-empty string, got {name!r}")
+    if not (name.startswith(PETSC_PREFIXES) or name in PETSC_GLOBAL):
+        raise InputError(f"unknown option -{name}: not a PETSc option of this program's "
+                         f"solvers (prefixes {', '.join(PETSC_PREFIXES)}){hint()}")
+
+
+def petsc_options_from_argv(argv=None) -> dict:
+    """The PETSc options of a script's command line, for ``petsc_options=`` of
+    :func:`~damage_dolfinx.run` (and ``steps``, ``converge``, ``sweep``)::
+
+        # python my_run.py -mech_ksp_type cg -damage_snes_monitor
+        dd.run(problem, "results/mine", petsc_options=dd.petsc_options_from_argv())
+
+    ``argv``: the words to read (default ``sys.argv[1:]``; a script with options of its own
+    passes what its parser left, ``parser.parse_known_args()[1]``). Every single-dash word
+    (``-name``, not a number) is a PETSc option, its value the next word unless that is an
+    option too; a double-dash option and any other word are the script's and skipped. A
+    single-dash name outside the package's solver prefixes is refused (InputError), as on the
+    command line; values are checked by the run itself, before any work."""
+    import sys as _sys
+    tokens = list(_sys.argv[1:] if argv is None else argv)
+    if not all(isinstance(t, str) for t in tokens):
+        from damage_dolfinx.parameters import InputError
+        raise InputError("petsc_options_from_argv: argv is a list of strings")
+    out, i = {}, 0
+    while i < len(tokens):
+        tok = tokens[i]
+        if tok.startswith("-") and not tok.startswith("--") and len(tok) > 1 and _is_option(tok):
+            value = tokens[i + 1] if i + 1 < len(tokens) and not _is_option(tokens[i + 1]) \
+                else ""
+            _check_name(tok[1:])
+            out[tok[1:]] = value
+            i += 2 if value != "" else 1
+        else:
+            i += 1
+    return out
+
+
+def normalised(options) -> dict:
+    """``petsc_options`` of the API -> {name: value string}: a mapping of names (with or
+    without the dash) to values (str, int, float, bool; None or "" for a flag); InputError for
+    a name outside the package's prefixes or a value of another type."""
+    import math
+    import numbers
+    from damage_dolfinx.parameters import InputError
+    if options is None:
+        return {}
+    if isinstance(options, (str, bytes)) or not hasattr(options, "items"):
+        raise InputError("petsc_options must be a mapping {name: value}, e.g. "
+                         "{'mech_ksp_type': 'cg'} (a script's command line: "
+                         "petsc_options=dd.petsc_options_from_argv()), got "
+                         f"{type(options).__name__}")
+    out = {}
+    for key, value in options.items():
+        name = key[1:] if isinstance(key, str) and key.startswith("-") else key
+        _check_name(name)
+        if value is None:
+            value = ""
+        elif isinstance(value, bool):
+            value = "true" if value else "false"
+        elif isinstance(value, numbers.Real) and not isinstance(value, bool):
+            if not math.isfinite(float(value)):
+                raise InputError(f"petsc_options: -{name} must be finite, got {value}")
+            value = repr(value.item() if hasattr(value, "item") else value)
+        elif not isinstance(value, str):
+            raise InputError(f"petsc_options: the value of -{name} is a string or a number, "
+                             f"got {type(value).__name__}")
+        if name in out:
+            raise InputError(f"petsc_options: -{name} is given twice")
+        out[name] = value
+    return out
+
+
+class scoped:
+    """The API's PETSc options for one call (a context manager, collective under MPI): checked
+    on entry (names, then values on throwaway solvers: InputError before any work), in the
+    options database during the call, then removed, the database's earlier values of the same
+    names restored; an option no solver of the call read is warned about on leaving
+    (``UserWarning`` on rank 0)."""
+
+    def __init__(self, options, comm, what="run"):
+        self.given = normalised(options)
+        self.comm, self.what, self._before = comm, what, {}
+
+    def __enter__(self):
+        if not self.given:
+            return self
+        from petsc4py import PETSc
+        opts = PETSc.Options()
+        self._before = {n: opts.getString(n) for n in self.given if opts.hasName(n)}
+        for name, value in self.given.items():
+            opts[name] = value
+        try:
+            _check_petsc_values(self.given)
+        except BaseException:
+            self._restore()
+            raise
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if not self.given:
+            return False
+        try:
+            if exc_type is None:
+                unused = _unused(self.given, self.comm)
+                if unused and self.comm.rank == 0:
+                    import warnings
+                    warnings.warn(f"no solver of this {self.what} read the PETSc option(s) "
+                                  f"{' '.join(unused)}: they had no effect", UserWarning,
+                                  stacklevel=3)
+        finally:
+            self._restore()
+        return False
+
+    def _restore(self):
+        from petsc4py import PETSc
+        opts = PETSc.Options()
+        for name in self.given:
+            opts.delValue(name)
+        for name, value in self._before.items():
+            opts[name] = value
 
 
 def _suggestion(option, parser, command) -> str:
