@@ -100,4 +100,6 @@ class MyElastic(dd.model_class("2.1")):
 PY
 step damage-dolfinx run my-elastic --plugin ./my_model.py --no-figures --quiet --out run-mine
 test -f run-mine/summary.json
+# the same plugin as a module of the current folder (a console script does not see it)
+DAMAGE_DOLFINX_PLUGINS=my_model LINES_SHOWN=8 step damage-dolfinx show my-elastic
 echo "check-wheel: all passed ($(damage-dolfinx --version))"
