@@ -59,8 +59,8 @@ def _parser():
     from damage_dolfinx import __version__
     p = _Parser(prog="damage-dolfinx", allow_abbrev=False, epilog=_EPILOG,
                 description="Damage models of Campo (2007) with DOLFINx: run an example of "
-                            "the thesis catalogue (or a model or example a plugin registers), "
-                            "study its convergence, sweep its parameters. "
+                            "the thesis catalogue\n(or a model or example a plugin registers), "
+                            "study its convergence, sweep its parameters.\n"
                             "`damage-dolfinx COMMAND -h` shows a command's options.")
     p.add_argument("--version", action="version", version=f"damage-dolfinx {__version__}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser,
@@ -69,7 +69,8 @@ def _parser():
                                              "registers)", allow_abbrev=False))
     show = sub.add_parser("show", help="an example's data before running it: n, k, T, mesh, "
                                        "reading, parameters", allow_abbrev=False)
-    show.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`), or a registered model's id")
+    show.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`), or the id of a model "
+                                 "or example a plugin registers")
     show.add_argument("--reading", choices=("literal", "evidence"),
                       help="the data under this reading (default: the example's)")
     show.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
@@ -159,7 +160,8 @@ def _sweep_parser(sub):
                                     "--ranks-per-point R runs each point in parallel on a "
                                     "group of R ranks; --point I runs point I alone (a job of "
                                     "a job array: several jobs may write OUT at once).")
-    sw.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`)")
+    sw.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`), or the id of a model or "
+                               "example a plugin registers")
     sw.add_argument("--set", action="append", default=[], metavar="NAME=V1,V2,...",
                     help="a swept parameter and its values, e.g. --set kappa=0.01,0.1,1 "
                          "(repeatable; one value fixes the parameter)")
