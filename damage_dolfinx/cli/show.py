@@ -14,7 +14,7 @@ def show(case_id, overrides) -> str:
     run = ex.configure(overrides={k: v for k, v in overrides.items() if k != "reading"})
     info = model_info(ex.model)
     lines = [f"{case_id}: {getattr(ex, 'title', '') or info.title}"]
-    section = getattr(ex, "section", "")
+    section = "" if getattr(ex, "own", True) else getattr(ex, "section", "")
     lines.append(f"  model      {info.id} ({info.title})" + (f", thesis Section {section}"
                                                             if section else ""))
     if run.h is not None:
