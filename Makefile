@@ -51,7 +51,7 @@ system-deps:
 	  $(APT) update && $(APT) install -y $(APT_PACKAGES); \
 	fi
 
-$(VENV)/.installed: pyproject.toml | system-deps
+$(VENV)/.installed: pyproject.toml setup.py | system-deps
 	/usr/bin/python3 -m venv --system-site-packages $(VENV)
 	$(PY) -m pip install --quiet --no-build-isolation --no-deps -e .
 	touch $@

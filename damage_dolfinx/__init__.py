@@ -11,8 +11,11 @@ The public face (everything else is internal and may change):
 * :class:`Model` (the base of every model: a model of your own derives from it, from the
   building blocks of :mod:`damage_dolfinx.models.blocks`), :class:`SubStep`
   (a model is built from a :class:`Problem` whose mesh is built), :func:`register_model`,
-  :func:`model_class` (a model's class by id);
+  :func:`model_class` (a model's class by id), :func:`register_example` (a Problem runnable
+  by its id, e.g. from the command line through a plugin);
 * :class:`DamageLaw` and the thesis laws :data:`THESIS_A`, :data:`THESIS_B`;
+* :func:`petsc_options_from_argv`: the PETSc options of your script's command line
+  (``python my_run.py -mech_ksp_type cg``), for ``run(..., petsc_options=...)``;
 * :func:`read_run`: a run folder back into a script (summary, history arrays, fields at any
   stored time);
 * :func:`read_mesh`, :func:`from_gmsh`: meshes from gmsh files or models;
@@ -27,11 +30,18 @@ Names are imported on first use, so ``import damage_dolfinx`` stays light.
 """
 from damage_dolfinx.core.version import __version__  # noqa: F401
 
+# the user's root logger is theirs: FFCx's configuration of it at import is undone, whichever
+# of the package's modules imports DOLFINx first (core/logs.py; no DOLFINx import here)
+from damage_dolfinx.core.logs import keep_root_at_ffcx_import as _keep  # noqa: E402
+
+_keep()
+del _keep
+
 __all__ = ["Problem", "MODELS", "model_defaults", "run", "steps", "converge", "sweep", "gather",
            "Model", "SubStep", "register_model", "model_class", "blocks",
            "DamageLaw", "THESIS_A", "THESIS_B", "read_mesh", "from_gmsh", "ModelParameters",
            "InputError", "ConvergenceError", "OutputError", "RunInterrupted", "read_run",
-           "check_model"]
+           "check_model", "register_example", "petsc_options_from_argv"]
 
 _WHERE = {"Problem": "problem.problem", "run": "api.workflow", "steps": "api.workflow",
           "Model": "models.base", "SubStep": "models.base", "converge": "api.workflow",
@@ -40,7 +50,9 @@ _WHERE = {"Problem": "problem.problem", "run": "api.workflow", "steps": "api.wor
           "from_gmsh": "problem.meshes", "ModelParameters": "core.parameters",
           "InputError": "core.errors", "read_run": "api.results",
           "ConvergenceError": "core.errors", "OutputError": "core.errors",
-          "RunInterrupted": "core.errors", "check_model": "api.model_check"}
+          "RunInterrupted": "core.errors", "check_model": "api.model_check",
+          "register_example": "runtime.cases",
+          "petsc_options_from_argv": "problem.petsc_options"}
 
 
 def __getattr__(name):

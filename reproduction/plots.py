@@ -11,7 +11,7 @@ from pathlib import Path
 def thesis_beside_ours(entry: dict, path: Path, title: str) -> Path:
     """Write ``path`` (PNG) for one table entry of fidelity.py; returns it."""
     from damage_dolfinx.viz import figstyle
-    plt = figstyle.plt()
+    plt = figstyle.pyplot_styled()
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     ks = sorted({c["k"] for c in entry["cells"]}, reverse=True)
     colours = plt.get_cmap("viridis")([i / max(1, len(ks) - 1) * 0.9 for i in range(len(ks))])

@@ -40,7 +40,7 @@ def main():
     records.draw_figure = timed
     start = time.perf_counter()
     from damage_dolfinx.viz import figstyle
-    figstyle.plt()  # matplotlib's import, apart from the drawing
+    figstyle.pyplot_styled()  # matplotlib's import, apart from the drawing
     mpl_import = time.perf_counter() - start
     out = args.out or tempfile.mkdtemp()
     sys.argv = ["damage-dolfinx", "run", args.example, "--n", str(args.n),

@@ -400,7 +400,7 @@ def variants_table(rows) -> list:
 
 def plot(rows, path: Path):
     from damage_dolfinx.viz import figstyle
-    fig, axes = figstyle.plt().subplots(1, len(EXAMPLES), figsize=(11, 4))
+    fig, axes = figstyle.pyplot_styled().subplots(1, len(EXAMPLES), figsize=(11, 4))
     for ax, example in zip(axes, EXAMPLES):
         for (mode, ranks), style in {("auto", 1): "o-C0", ("auto", 2): "s-C1",
                                      ("direct", 1): "^:C2", ("direct", 2): "v:C3"}.items():

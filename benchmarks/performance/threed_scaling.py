@@ -134,7 +134,7 @@ def table(kind: str, rows) -> str:
 def plot(kind: str, rows, path: Path):
     from damage_dolfinx.viz import figstyle
     example, _, columns, _ = KINDS[kind]
-    fig, (a1, a2, a3) = figstyle.plt().subplots(1, 3, figsize=(13, 3.8))
+    fig, (a1, a2, a3) = figstyle.pyplot_styled().subplots(1, 3, figsize=(13, 3.8))
     for ranks, colour in ((1, "C0"), (2, "C1")):
         sel = [r for r in rows if r["ranks"] == ranks]
         if not sel:

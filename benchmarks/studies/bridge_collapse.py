@@ -64,7 +64,7 @@ def plot_curve(P, d, summary, path):
     """Figure 2.7 (figstyle): our curve, the thesis's two failure loads as lines named in the
     legend (no text over the curve), the collapse point."""
     from damage_dolfinx.viz import figstyle
-    pyplot = figstyle.plt()
+    pyplot = figstyle.pyplot_styled()
     fig, ax = pyplot.subplots(figsize=(6.4, 4.2))
     ax.plot(d, P, "o-", ms=3, label="damage model (this run)")
     for key, style, label in (("damage_model_kN", "--", "thesis, damage model"),
@@ -84,7 +84,7 @@ def plot_curve(P, d, summary, path):
 def plot_section_damage(summary, path):
     import numpy as np
     from damage_dolfinx.viz import figstyle
-    pyplot = figstyle.plt()
+    pyplot = figstyle.pyplot_styled()
     D = np.asarray(summary["failure_section_damage"])
     n = D.size - 1
     angle = np.linspace(0.0, 180.0, n + 1)

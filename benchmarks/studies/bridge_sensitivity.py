@@ -134,7 +134,7 @@ def write_tables(rows, out: Path):
 
 def plot(rows, path):
     from damage_dolfinx.viz import figstyle
-    fig, axes = figstyle.plt().subplots(1, 3, figsize=(13, 3.8))
+    fig, axes = figstyle.pyplot_styled().subplots(1, 3, figsize=(13, 3.8))
     for ax, (study, key, label) in zip(axes, (("mesh", "h", "mesh size $h$ [m]"),
                                               ("time step", "k", "time step $k$ [s]"),
                                               ("load rate", "load_rate", "load rate [kN/s]"))):

@@ -126,7 +126,7 @@ def rotation_at(summary, sections):
 
 def plot_sections(records, path, h_mesh):
     from damage_dolfinx.viz import figstyle
-    pyplot = figstyle.plt()
+    pyplot = figstyle.pyplot_styled()
     fig, ax = pyplot.subplots(figsize=(7.2, 3.8))
     for case, rec in records.items():
         D = np.asarray(rec["section_damage"])
@@ -230,7 +230,7 @@ def _plot_curves(first_csv, first_fail, first_label, others, path, h_mesh):
     """All cases on one load-displacement plot (hinge_lines.plot_load_displacement, extended)."""
     from damage_dolfinx.viz import figstyle
     from damage_dolfinx.viz.hinge_lines import read_curve
-    pyplot = figstyle.plt()
+    pyplot = figstyle.pyplot_styled()
     fig, ax = pyplot.subplots(figsize=(6.8, 4.4))
     for csv_path, fail, label in [(first_csv, first_fail, first_label)] + others:
         P, d = read_curve(csv_path)

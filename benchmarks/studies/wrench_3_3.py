@@ -67,7 +67,7 @@ def plot_deformed_mesh(stepper, amplification, path):
 
 def plot_penetration(history, path):
     from damage_dolfinx.viz import figstyle
-    pyplot = figstyle.plt()
+    pyplot = figstyle.pyplot_styled()
     with open(history) as f:
         rows = list(csv.DictReader(f))
     t = [float(r["t"]) for r in rows]

@@ -16,8 +16,10 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Union
 
 import numpy as np
 
@@ -102,7 +104,7 @@ def _history(path) -> dict:
     return {c: np.array([number(r.get(c)) for r in rows]) for c in rows[0]}
 
 
-def read_run(folder) -> RunResults:
+def read_run(folder: "Union[str, os.PathLike[str]]") -> RunResults:
     """Read the run folder ``folder`` (made by ``run`` or the command line, on any number of
     ranks, restarted or not): its summary, its history as arrays and its stored fields at any
     output time (``RunResults``). Raises InputError when the folder holds no run."""

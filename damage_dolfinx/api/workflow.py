@@ -1,10 +1,28 @@
 """Running problems: :func:`run` one problem into a run folder, :func:`converge` a problem
-against a fine reference, :func:`gather` a field onto rank 0 (any number of ranks)."""
+against a fine reference, :func:`gather` a field onto rank 0 (any number of ranks).
+
+``petsc_options`` (all four calls): PETSc options of the package's solvers for this call only,
+``{"mech_ksp_type": "cg", "damage_snes_monitor": None}`` (names with or without the dash,
+values str/number/bool, None for a flag), checked as the command line checks its own: a name
+outside the solver prefixes (``mech_``, ``damage_``, ``friction_``, ``uzawa_``, ``pd_``,
+``stability_``) or a value PETSc refuses raises InputError before any work, an option no solver
+read is warned about (UserWarning) at the end, and the options database is as before after the
+call. A script's own command line: ``petsc_options=dd.petsc_options_from_argv()``."""
 from __future__ import annotations
+
+import os
+from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from mpi4py import MPI
 
+from damage_dolfinx.problem.problem import Problem  # (light: no DOLFINx, for the annotations)
 from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS
+from damage_dolfinx.runtime.steps import Steps
+
+#: what a run is given: a Problem, or the id of a catalogue or registered example
+ProblemLike = Union["Problem", str]
+PathLike = Union[str, "os.PathLike[str]"]
+PetscOptions = Optional[Mapping[str, Any]]
 
 
 def _named(problem):
@@ -15,10 +33,20 @@ def _named(problem):
     return problem
 
 
-def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD,
-        on_step=None, h=None, overrides=None, mesh_file=None, write_every=None,
-        checkpoint_seconds=CHECKPOINT_SECONDS, history_every=None) -> dict:
+def _petsc(petsc_options, comm, what):
+    from damage_dolfinx.problem.petsc_options import scoped
+    return scoped(petsc_options, comm, what)
+
+
+def run(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
+        k: Optional[float] = None, T: Optional[float] = None, restart: bool = False,
+        overwrite: bool = False, checkpoint_every: Optional[int] = None, progress: bool = True,
+        figures: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+        on_step: Optional[Callable[[Any], Any]] = None,
+        petsc_options: PetscOptions = None, h: Optional[float] = None,
+        overrides: Optional[Mapping[str, Any]] = None, mesh_file: Optional[PathLike] = None,
+        write_every: Optional[int] = None, checkpoint_seconds: float = CHECKPOINT_SECONDS,
+        history_every: Optional[int] = None) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
     ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
     ``out/summary.json``).
@@ -42,6 +70,7 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
     catalogue example's mesh), ``write_every`` (fields every that many steps), ``history_every``
     (a history row every that many steps), ``checkpoint_every`` / ``checkpoint_seconds`` (a
     checkpoint every that many steps, else every that many seconds of wall time; 0: none).
+    ``petsc_options``: PETSc options of this run's solvers (the module's docstring).
 
     Raises (all importable from ``damage_dolfinx``; damage_dolfinx.core.errors):
 
@@ -65,14 +94,19 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
                             mesh_file=mesh_file, write_every=write_every,
                             checkpoint_seconds=checkpoint_seconds, history_every=history_every)
         checked.pop("comm", None)
-        return _run(_named(problem), out, comm=comm, **{k_: v for k_, v in checked.items()
-                                                        if k_ != "out"})
+        checked.pop("out", None)
+        with _petsc(petsc_options, comm, "run"):
+            return _run(_named(problem), out, comm=comm, **checked)
 
 
-def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD, h=None,
-          overrides=None, mesh_file=None, write_every=None,
-          checkpoint_seconds=CHECKPOINT_SECONDS, history_every=None):
+def steps(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
+          k: Optional[float] = None, T: Optional[float] = None, restart: bool = False,
+          overwrite: bool = False, checkpoint_every: Optional[int] = None,
+          progress: bool = True, figures: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+          petsc_options: PetscOptions = None, h: Optional[float] = None,
+          overrides: Optional[Mapping[str, Any]] = None, mesh_file: Optional[PathLike] = None,
+          write_every: Optional[int] = None, checkpoint_seconds: float = CHECKPOINT_SECONDS,
+          history_every: Optional[int] = None) -> "Steps":
     """The run of :func:`run` (the same arguments, the same run folder), step by step::
 
         with dd.steps(problem, "results/mine") as run:
@@ -111,14 +145,35 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
                             write_every=write_every, checkpoint_seconds=checkpoint_seconds,
                             history_every=history_every)
         checked.pop("comm", None)
-        run = Run.prepare(_named(problem), out, comm=comm,
-                          **{k_: v for k_, v in checked.items() if k_ != "out"})
-    return Steps(run, comm)
+        checked.pop("out", None)
+        scope = _petsc(petsc_options, comm, "run")
+        scope.__enter__()  # left when the steps end (_within)
+        try:
+            run = Run.prepare(_named(problem), out, comm=comm, **checked)
+        except BaseException:
+            scope._restore()
+            raise
+    return Steps(run, comm, within=lambda steps: _within(steps, scope))
 
 
-def converge(problem, out, *, n=None, k=None, ref_n=None, ref_k=None, T=None, progress=True,
-             restart=False, overwrite=True, comm=MPI.COMM_WORLD, overrides=None,
-             reference_ranks=None) -> dict:
+def _within(steps: Iterator, scope) -> Iterator:
+    """The steps with the run's PETSc options in force until they end: the unread ones are
+    warned about when the run goes to its end (a loop left early, or an exception, only
+    restores the options database: no collective call there)."""
+    try:
+        yield from steps
+    except BaseException:
+        scope._restore()
+        raise
+    scope.__exit__(None, None, None)
+
+
+def converge(problem: ProblemLike, out: PathLike, *, n: Optional[Sequence[int]] = None,
+             k: Optional[Sequence[float]] = None, ref_n: Optional[int] = None,
+             ref_k: Optional[float] = None, T: Optional[float] = None, progress: bool = True,
+             restart: bool = False, overwrite: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+             petsc_options: PetscOptions = None, overrides: Optional[Mapping[str, Any]] = None,
+             reference_ranks: Union[int, str, None] = None) -> dict:
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
     run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
     and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
@@ -133,12 +188,12 @@ def converge(problem, out, *, n=None, k=None, ref_n=None, ref_k=None, T=None, pr
     holding a study: nothing to do when it completed with these settings, else it runs again
     (studies keep no checkpoints); a study whose settings or run fingerprint at any level (mesh,
     loads, law, ... as a run's restart checks) differ is refused, naming what changed.
-    ``overwrite=False`` refuses a folder that holds a study. ``n``, ``k``, ``ref_n``, ``ref_k``
-    left None take a catalogue example's default study (a problem of your own has none: give
-    them). ``overrides``: changes to the problem's data, as for :func:`run`;
-    ``reference_ranks``: 1 (the reference serially, the coarse cells on the other ranks) or
-    "all" (None: the example's default, else 1). The command line's ``converge`` calls this
-    function."""
+    ``overwrite=False`` refuses a folder that holds a study. ``petsc_options``: PETSc options of
+    every run of the study (the module's docstring). ``n``, ``k``, ``ref_n``, ``ref_k`` left
+    None take a catalogue example's default study (a problem of your own has none: give them).
+    ``overrides``: changes to the problem's data, as for :func:`run`; ``reference_ranks``: 1
+    (the reference serially, the coarse cells on the other ranks) or "all" (None: the
+    example's default, else 1). The command line's ``converge`` calls this function."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
     from damage_dolfinx.core.validation import arguments, check_converge, communicator
@@ -147,12 +202,13 @@ def converge(problem, out, *, n=None, k=None, ref_n=None, ref_k=None, T=None, pr
             n, k, ref_n, ref_k, T, restart, overwrite, progress, out, comm)
         checked = arguments(overrides=overrides, reference_ranks=reference_ranks)
         overrides, reference_ranks = checked["overrides"], checked["reference_ranks"]
-        return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
-                     progress=progress, comm=comm, restart=restart, overwrite=overwrite,
-                     overrides=overrides, reference_ranks=reference_ranks)
+        with _petsc(petsc_options, comm, "convergence study"):
+            return study(_named(problem), out, ref_n=ref_n, ref_k=ref_k, ns=n, ks=k, T=T,
+                         progress=progress, comm=comm, restart=restart, overwrite=overwrite,
+                         overrides=overrides, reference_ranks=reference_ranks)
 
 
-def gather(function):
+def gather(function: Any) -> "Optional[tuple[Any, Any]]":
     """``(coords, values)`` of a P1 or DG0 ``dolfinx.fem.Function`` on rank 0, all ranks'
     owned dofs in a rank-independent order (sorted by coordinates), so that a serial run and a
     parallel one compare entry by entry; ``None`` on the other ranks (collective)."""
@@ -160,14 +216,27 @@ def gather(function):
     return gather_dof_field(function)
 
 
-def sweep(problem, out, grid, **kwargs) -> dict:
+def sweep(problem: ProblemLike, out: PathLike, grid: Mapping[str, Sequence[Any]], *,
+          n: Optional[int] = None, k: Optional[float] = None, T: Optional[float] = None,
+          restart: bool = False, max_points: Optional[int] = None, plot: str = "zeta_min",
+          figures: bool = True, progress: bool = True, ranks_per_point: Optional[int] = None,
+          point: Optional[int] = None, comm: MPI.Comm = MPI.COMM_WORLD,
+          petsc_options: PetscOptions = None) -> dict:
+    from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.sweep import sweep as _sweep
-    return _sweep(_named(problem), out, grid, **kwargs)
+    from damage_dolfinx.core.validation import communicator
+    with outcome(communicator("comm", comm)):
+        scope = _petsc(petsc_options, comm, "sweep")
+    with scope:
+        return _sweep(_named(problem), out, grid, n=n, k=k, T=T, restart=restart,
+                      max_points=max_points, plot=plot, figures=figures, progress=progress,
+                      ranks_per_point=ranks_per_point, point=point, comm=comm)
 
 
 def _sweep_doc():
     from damage_dolfinx.studies.sweep import sweep as _sweep  # light: no DOLFINx import
-    return _sweep.__doc__
+    return _sweep.__doc__ + """
+    ``petsc_options``: PETSc options of every point's run (this module's docstring)."""
 
 
 sweep.__doc__ = _sweep_doc()

@@ -34,6 +34,7 @@ def get(example_id: str, reading=None) -> Example:
         raise InputError(f"unknown reading {reading!r}; known: {', '.join(READINGS)}")
     examples = catalogue(reading)
     if example_id not in examples:
-        raise InputError(f"unknown example id {example_id!r}; known ids: {', '.join(examples)} "
+        from damage_dolfinx.runtime.cases import UnknownCase  # (the next source is tried)
+        raise UnknownCase(f"unknown example id {example_id!r}; known ids: {', '.join(examples)} "
                          f"(see `damage-dolfinx list`)")
     return examples[example_id]

@@ -5,33 +5,88 @@ from __future__ import annotations
 import argparse
 
 
+class _Formatter(argparse.RawDescriptionHelpFormatter):
+    """Help with every default shown (argparse's ArgumentDefaultsHelpFormatter, without the
+    "(default: None)" of an option whose default is the example's own: its help says so)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "%(default)" in text or action.default in (None, False, [], argparse.SUPPRESS):
+            return text
+        if action.option_strings or action.nargs in (argparse.OPTIONAL, argparse.ZERO_OR_MORE):
+            text += " (default: %(default)s)"
+        return text
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (InputError, exit status 2) and only the long form of
-    help: ``-h`` is the mesh size misspelt (--h), not a request for help."""
+    """argparse with one-line errors (InputError, exit status 2), the defaults in the help,
+    and ``-h``/``--help`` (``-h`` followed by a number is the mesh size misspelt, refused by
+    the command: did you mean --h?)."""
 
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("add_help", False)
+        kwargs.setdefault("formatter_class", _Formatter)
         super().__init__(*args, **kwargs)
-        self.add_argument("--help", action="help", help="show this help and exit")
+        self.add_argument("-h", "--help", action="help", help="show this help and exit")
 
     def error(self, message):
         from damage_dolfinx.core.parameters import InputError
         raise InputError(message)
 
 
+#: the logging levels of --log-level
+LOG_LEVELS = ("debug", "info", "warning", "error")
+
+_EPILOG = """\
+Single-dash options are PETSc options of the solvers (-mech_ksp_type cg, -damage_snes_monitor;
+prefixes mech_ damage_ friction_ uzawa_ pd_ stability_). Plugins (--plugin, or the
+comma-separated DAMAGE_DOLFINX_PLUGINS): a module on the path or in the current folder, or a
+file (./my_model.py), imported before the command; it may register models and examples.
+Exit status: 0 done, 2 bad input, 3 solver failure, 4 output error, 128+N signal N."""
+
+
+def _add_session(sp):
+    """Options of every subcommand: plugins and logging."""
+    sp.add_argument("--plugin", action="append", default=[], metavar="MODULE|FILE.py",
+                    help="import a plugin before the command (repeatable; also "
+                         "DAMAGE_DOLFINX_PLUGINS): a module on the path or in the current "
+                         "folder, or a file path")
+    sp.add_argument("--log-level", choices=LOG_LEVELS, default="warning",
+                    help="messages of the package's logger (damage_dolfinx) shown on stderr")
+
+
 def _parser():
-    p = _Parser(prog="damage-dolfinx", allow_abbrev=False,
-                description="Damage models of Campo (2007) with DOLFINx.")
-    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    sub.add_parser("list", help="list the example ids")
+    from damage_dolfinx.core.version import __version__
+    p = _Parser(prog="damage-dolfinx", allow_abbrev=False, epilog=_EPILOG,
+                description="Damage models of Campo (2007) with DOLFINx: run an example of "
+                            "the thesis catalogue\n(or a model or example a plugin registers), "
+                            "study its convergence, sweep its parameters.\n"
+                            "`damage-dolfinx COMMAND -h` shows a command's options.")
+    p.add_argument("--version", action="version", version=f"damage-dolfinx {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser,
+                           metavar="{list,show,run,converge,sweep}")
+    _add_session(sub.add_parser("list", help="list the example ids (and the models a plugin "
+                                             "registers)", allow_abbrev=False))
+    show = sub.add_parser("show", help="an example's data before running it: n, k, T, mesh, "
+                                       "reading, parameters", allow_abbrev=False)
+    show.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`), or the id of a model "
+                                 "or example a plugin registers")
+    show.add_argument("--reading", choices=("literal", "evidence"),
+                      help="the data under this reading (default: the example's)")
+    show.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                      help="the data with this parameter overridden (repeatable)")
+    _add_session(show)
 
     def common(sp):
-        sp.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`)")
-        sp.add_argument("--T", type=float, help="final time")
+        sp.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`), or the id of a "
+                                   "model or example a plugin registers")
+        sp.add_argument("--T", type=float, help="final time (default: the example's, see "
+                                                "`show ID`)")
         sp.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                         help="override a model parameter, e.g. --set kappa=0.01 (repeatable)")
         sp.add_argument("--out", required=True, help="output folder")
         sp.add_argument("--quiet", action="store_true", help="no progress lines")
+        _add_session(sp)
         sp.add_argument("--allow-unstable", action="store_true",
                         help="run a time step above the scheme's stability limit k_max (a "
                              "warning instead of a refusal), to study instability on purpose")
@@ -49,9 +104,12 @@ def _parser():
 
     run = sub.add_parser("run", help="run one example", allow_abbrev=False)
     common(run)
-    run.add_argument("--n", type=int, help="cells per side (structured meshes)")
-    run.add_argument("--h", type=float, help="element size (gmsh meshes)")
-    run.add_argument("--k", type=float, help="time step")
+    run.add_argument("--n", type=int, help="cells per side (structured meshes; default: the "
+                                           "example's, see `show ID`)")
+    run.add_argument("--h", type=float, help="element size (gmsh meshes; default: the "
+                                             "example's)")
+    run.add_argument("--k", type=float, help="time step (default: the example's, within its "
+                                             "stability limit)")
     run.add_argument("--mesh", help="gmsh .msh file replacing the built-in geometry")
     run.add_argument("--write-every", type=int, help="XDMF output every N steps (default N/20)")
     run.add_argument("--history-every", type=int, metavar="N",
@@ -61,7 +119,7 @@ def _parser():
                      help="write a checkpoint every STEPS steps (default: every "
                           "--checkpoint-seconds of wall time)")
     run.add_argument("--checkpoint-seconds", type=float, default=120.0,
-                     help="wall-time interval between checkpoints (0: none; default 120)")
+                     help="wall-time interval between checkpoints (0: none)")
     run.add_argument("--restart", action="store_true",
                      help="resume from the checkpoint in --out (any number of MPI ranks)")
     run.add_argument("--overwrite", action="store_true",
@@ -102,7 +160,8 @@ def _sweep_parser(sub):
                                     "--ranks-per-point R runs each point in parallel on a "
                                     "group of R ranks; --point I runs point I alone (a job of "
                                     "a job array: several jobs may write OUT at once).")
-    sw.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`)")
+    sw.add_argument("id", help="example id, e.g. 2.1-ex1 (see `list`), or the id of a model or "
+                               "example a plugin registers")
     sw.add_argument("--set", action="append", default=[], metavar="NAME=V1,V2,...",
                     help="a swept parameter and its values, e.g. --set kappa=0.01,0.1,1 "
                          "(repeatable; one value fixes the parameter)")
@@ -123,9 +182,10 @@ def _sweep_parser(sub):
                          "job of a job array (e.g. --point $SLURM_ARRAY_TASK_ID); a completed "
                          "point is not run again")
     sw.add_argument("--plot", default="zeta_min", metavar="SCALAR",
-                    help="final scalar drawn against the swept parameters (default zeta_min)")
+                    help="final scalar drawn against the swept parameters")
     sw.add_argument("--no-figures", action="store_true", help="no PNG figures per point")
     sw.add_argument("--quiet", action="store_true", help="no progress lines")
+    _add_session(sw)
 
 
 def _overrides(pairs, friction_solver=None, friction_law=None, reading=None, args=None):

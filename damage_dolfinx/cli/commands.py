@@ -14,12 +14,49 @@ from damage_dolfinx.problem.petsc_options import _check_petsc_values, _petsc_opt
 
 def command(argv, comm, given):
     """Parse and run the command; returns 0 (exceptions: main)."""
+    import logging
+    argv = _help_or_mesh_size(sys.argv[1:] if argv is None else list(argv))
     parser = _parser()
     args, extra = parser.parse_known_args(argv)
     given.update(_petsc_options(extra, parser, args.command))
     _check_finite(args)
     _check_petsc_values(given)
-    _load_plugins()
+    handler = _logging(args.log_level, comm)
+    try:
+        return _command(args, comm, given)
+    finally:
+        logging.getLogger("damage_dolfinx").removeHandler(handler)
+
+
+def _help_or_mesh_size(argv):
+    """``-h`` asks for help, except ``-h NUMBER``: the mesh size misspelt (``--h``)."""
+    from damage_dolfinx.core.parameters import InputError
+    for i, tok in enumerate(argv):
+        if tok == "-h" and i + 1 < len(argv):
+            try:
+                float(argv[i + 1])
+            except ValueError:
+                continue
+            raise InputError("unknown option -h: not a PETSc option of this program's solvers "
+                             "(-h alone is the help); did you mean --h?")
+    return argv
+
+
+def _logging(level, comm):
+    """The command's handler of the package's logger (stderr, rank 0; ``--log-level``); the
+    root logger is left alone."""
+    import logging
+    logger = logging.getLogger("damage_dolfinx")
+    handler = logging.StreamHandler(sys.stderr) if comm.rank == 0 else logging.NullHandler()
+    handler.setFormatter(logging.Formatter("damage-dolfinx: %(levelname)s: %(message)s"))
+    logger.addHandler(handler)
+    logger.setLevel(getattr(logging, level.upper()))
+    return handler
+
+
+def _command(args, comm, given):
+    from damage_dolfinx.cli import plugins
+    plugins.load(args.plugin)
     if args.command != "list":
         from damage_dolfinx.runtime.signals import keeping_sigint
         with keeping_sigint():  # gmsh itself only where a mesh needs it (geometries)
@@ -27,9 +64,18 @@ def command(argv, comm, given):
     from damage_dolfinx.catalogue import examples  # the catalogue's ids (runtime/cases.py)
     if args.command == "list":
         if comm.rank == 0:
+            from damage_dolfinx.runtime import cases
             for ex in examples.catalogue().values():
                 reading = f" (reading: {ex.reading})" if ex.readings else ""
                 print(f"{ex.id:10s} [Section {ex.section}] {ex.title}{reading}")
+            for name, title in cases.registered().items():
+                print(f"{name:10s} [registered] {title}")
+        return 0
+    if args.command == "show":
+        from damage_dolfinx.cli.show import show
+        text = show(args.id, _overrides(args.set, reading=args.reading))
+        if comm.rank == 0:
+            print(text, flush=True)
         return 0
     # every command is a client of the public API: the same entry points and checks a script
     # meets (damage_dolfinx.api.workflow; core.validation checks each argument by its name)
@@ -94,17 +140,3 @@ def _sweep(args):
                   f"points failed (point_{first}: {why})", file=sys.stderr, flush=True)
         return 3
     return 0
-
-
-def _load_plugins():
-    """Import the modules named in DAMAGE_DOLFINX_PLUGINS (comma-separated): they may register
-    models (damage_dolfinx.register_model), friction solvers or case sources before the run."""
-    import importlib
-    from damage_dolfinx.core.parameters import InputError
-    for name in filter(None, (n.strip() for n in os.environ.get("DAMAGE_DOLFINX_PLUGINS",
-                                                                  "").split(","))):
-        try:
-            importlib.import_module(name)
-        except ImportError as exc:
-            raise InputError(f"DAMAGE_DOLFINX_PLUGINS names {name!r}, which cannot be "
-                             f"imported: {exc}") from None

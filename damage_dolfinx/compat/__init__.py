@@ -12,24 +12,14 @@ grouped by concept and all importable from here (``compat.form``, ``compat.vecto
 """
 from __future__ import annotations
 
-import logging
+from damage_dolfinx.core.logs import LOGGER, root_kept  # noqa: F401
 
-import dolfinx
-import dolfinx.fem.petsc  # noqa: F401  (0.7+ no longer imports it implicitly)
-from petsc4py import PETSc
-
-import ffcx  # noqa: E402,F401  (installs a root log handler at import)
-
-
-class _WarningsOnly(logging.Filter):
-    def filter(self, record):
-        return record.levelno >= logging.WARNING
-
-
-# The JIT's C compilation (setuptools) logs every build at INFO on the root logger, and
-# setuptools resets the root level while doing so: filter at the handlers instead.
-for _handler in logging.getLogger().handlers:
-    _handler.addFilter(_WarningsOnly())
+# FFCx 0.5 configures the root logger at import (basicConfig, captureWarnings): undone (core/logs.py)
+with root_kept():
+    import dolfinx
+    import dolfinx.fem.petsc  # noqa: F401  (0.7+ no longer imports it implicitly)
+    import ffcx  # noqa: F401
+from petsc4py import PETSc  # noqa: E402
 
 DOLFINX_VERSION = dolfinx.__version__
 ScalarType = getattr(dolfinx, "default_scalar_type", PETSc.ScalarType)

@@ -6,9 +6,11 @@ from __future__ import annotations
 import inspect
 
 import numpy as np
-import dolfinx.fem.petsc  # noqa: F401  (0.7+ no longer imports it implicitly)
+import dolfinx.fem.petsc  # noqa: F401  (0.7+ no longer imports it implicitly; compat/__init__ first)
 from dolfinx import fem
 from petsc4py import PETSc
+
+from damage_dolfinx.core.logs import root_kept
 
 
 def petsc_vec(u: fem.Function) -> PETSc.Vec:
@@ -89,15 +91,17 @@ _FORM_TYPES = tuple(t for t in (getattr(fem, "FormMetaClass", None), getattr(fem
 
 
 def form(ufl_form, jit_options=None):
-    """Compiled form; JIT options are 'jit_params' up to 0.5, 'jit_options' from 0.6 on."""
-    if not jit_options:
-        return fem.form(ufl_form)
-    return fem.form(ufl_form, **{_FORM_OPTIONS_KEY: jit_options})
+    """Compiled form; JIT options are 'jit_params' up to 0.5, 'jit_options' from 0.6 on (the
+    user's root logger kept: core/logs.py)."""
+    with root_kept(quiet=True):
+        if not jit_options:
+            return fem.form(ufl_form)
+        return fem.form(ufl_form, **{_FORM_OPTIONS_KEY: jit_options})
 
 
 def assemble_scalar(ufl_or_form, comm) -> float:
     """Globally summed integral of a scalar form (compiled or UFL)."""
-    f = ufl_or_form if isinstance(ufl_or_form, _FORM_TYPES) else fem.form(ufl_or_form)
+    f = ufl_or_form if isinstance(ufl_or_form, _FORM_TYPES) else form(ufl_or_form)
     return comm.allreduce(fem.assemble_scalar(f), op=_mpi_sum())
 
 

@@ -87,8 +87,11 @@ def interpolation_points(V):
 
 
 def expression(expr, V):
-    """A compiled fem.Expression of ``expr`` at the interpolation points of V."""
-    return fem.Expression(expr, interpolation_points(V))
+    """A compiled fem.Expression of ``expr`` at the interpolation points of V (the user's root
+    logger kept: core/logs.py)."""
+    from damage_dolfinx.core.logs import root_kept
+    with root_kept(quiet=True):
+        return fem.Expression(expr, interpolation_points(V))
 
 
 def eval_expression(expr, msh, cells):

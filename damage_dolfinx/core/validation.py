@@ -179,7 +179,15 @@ def mesh_file_path(name, value):
 
 #: every keyword argument of the entry points (run, steps, converge, sweep, read_mesh,
 #: from_gmsh), checked by its name: one rule per name, whichever function takes it
+def petsc_options(name, value):
+    """PETSc options of a call: the checks of the command line's options (names; the values on
+    throwaway solvers when the call starts: petsc_options.scoped)."""
+    from damage_dolfinx.core.petsc_names import normalised
+    return normalised(value)
+
+
 ARGUMENTS = {
+    "petsc_options": petsc_options,
     "out": path, "n": _maybe(whole), "k": _maybe(positive), "T": _maybe(positive),
     "restart": flag, "overwrite": flag, "progress": flag, "figures": flag,
     "checkpoint_every": _maybe(whole), "max_points": _maybe(whole),

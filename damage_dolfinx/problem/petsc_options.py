@@ -1,7 +1,10 @@
-"""PETSc options on the command line: single-dash words reach the package's solvers (prefixes
-PETSC_PREFIXES); any other single-dash word is refused with the double-dash option it
-resembles, a value PETSc refuses is refused before any work, and an option no solver read is
-named in a warning at the end."""
+"""PETSc options of the command line and of the API (``petsc_options=`` of ``run``, ``steps``,
+``converge``, ``sweep``; :func:`petsc_options_from_argv` for a script's own command line),
+checked alike, each check in one place: a name outside the package's solver prefixes
+(PETSC_PREFIXES, :func:`_check_name`) is refused (the command line suggests the double-dash
+option it resembles), a value PETSc refuses is refused before any work
+(:func:`_check_petsc_values`), and an option no solver read is named in a warning at the end
+(:func:`_unused`). The API's options hold for the one call only (:func:`scoped`)."""
 from __future__ import annotations
 
 import argparse
@@ -9,12 +12,10 @@ import sys
 
 from mpi4py import MPI
 
+from damage_dolfinx.core.petsc_names import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401
+                                               _check_name, normalised)
 
-#: prefixes of the package's PETSc solvers (an option -<prefix><name> reaches one of them)
-PETSC_PREFIXES = ("mech_", "damage_", "friction_", "uzawa_", "pd_", "stability_")
-#: PETSc options without a solver prefix that are accepted (diagnostics of the whole run)
-PETSC_GLOBAL = ("log_view", "options_left", "options_view", "info", "malloc_dump",
-                "memory_view", "log_trace")
+
 #: the part of an option name after which the PETSc object's own options start
 _OBJECT_PARTS = ("snes_", "ksp_", "pc_")
 
@@ -36,16 +37,95 @@ def _petsc_options(tokens, parser, command):
         if not tok.startswith("-") or len(tok) == 1 or not _is_option(tok):
             raise InputError(f"unrecognised argument {tok!r}")
         name = tok[1:]
-        if not (name.startswith(PETSC_PREFIXES) or name in PETSC_GLOBAL):
-            hint = _suggestion("--" + name, parser, command)
-            raise InputError(f"unknown option {tok}: not a PETSc option of this program's "
-                             f"solvers (prefixes {', '.join(PETSC_PREFIXES)}){hint}")
+        _check_name(name, lambda: _suggestion("--" + name, parser, command))
         given[name] = value if value is not None else ""
         i += 2 if value is not None else 1
     opts = PETSc.Options()
     for name, value in given.items():
         opts[name] = value
     return given
+
+
+def petsc_options_from_argv(argv=None) -> dict:
+    """The PETSc options of a script's command line, for ``petsc_options=`` of
+    :func:`~damage_dolfinx.run` (and ``steps``, ``converge``, ``sweep``)::
+
+        # python my_run.py -mech_ksp_type cg -damage_snes_monitor
+        dd.run(problem, "results/mine", petsc_options=dd.petsc_options_from_argv())
+
+    ``argv``: the words to read (default ``sys.argv[1:]``; a script with options of its own
+    passes what its parser left, ``parser.parse_known_args()[1]``). Every single-dash word
+    (``-name``, not a number) is a PETSc option, its value the next word unless that is an
+    option too; a double-dash option and any other word are the script's and skipped. A
+    single-dash name outside the package's solver prefixes is refused (InputError), as on the
+    command line; values are checked by the run itself, before any work."""
+    import sys as _sys
+    tokens = list(_sys.argv[1:] if argv is None else argv)
+    if not all(isinstance(t, str) for t in tokens):
+        from damage_dolfinx.core.parameters import InputError
+        raise InputError("petsc_options_from_argv: argv is a list of strings")
+    out, i = {}, 0
+    while i < len(tokens):
+        tok = tokens[i]
+        if tok.startswith("-") and not tok.startswith("--") and len(tok) > 1 and _is_option(tok):
+            value = tokens[i + 1] if i + 1 < len(tokens) and not _is_option(tokens[i + 1]) \
+                else ""
+            _check_name(tok[1:])
+            out[tok[1:]] = value
+            i += 2 if value != "" else 1
+        else:
+            i += 1
+    return out
+
+
+class scoped:
+    """The API's PETSc options for one call (a context manager, collective under MPI): checked
+    on entry (names, then values on throwaway solvers: InputError before any work), in the
+    options database during the call, then removed, the database's earlier values of the same
+    names restored; an option no solver of the call read is warned about on leaving
+    (``UserWarning`` on rank 0)."""
+
+    def __init__(self, options, comm, what="run"):
+        self.given = normalised(options)
+        self.comm, self.what, self._before = comm, what, {}
+
+    def __enter__(self):
+        if not self.given:
+            return self
+        from petsc4py import PETSc
+        opts = PETSc.Options()
+        self._before = {n: opts.getString(n) for n in self.given if opts.hasName(n)}
+        for name, value in self.given.items():
+            opts[name] = value
+        try:
+            _check_petsc_values(self.given)
+        except BaseException:
+            self._restore()
+            raise
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        if not self.given:
+            return False
+        try:
+            if exc_type is None:
+                unused = _unused(self.given, self.comm)
+                if unused and self.comm.rank == 0:
+                    import warnings
+                    warnings.warn(f"no solver of this {self.what} read the PETSc option(s) "
+                                  f"{' '.join(unused)}: they had no effect", UserWarning,
+                                  stacklevel=3)
+        finally:
+            self._restore()
+        return False
+
+    def _restore(self):
+        from petsc4py import PETSc
+        opts = PETSc.Options()
+        for name in self.given:
+            opts.delValue(name)
+        for name, value in self._before.items():
+            opts[name] = value
 
 
 def _suggestion(option, parser, command) -> str:

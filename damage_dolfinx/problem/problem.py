@@ -178,7 +178,7 @@ class Problem:
 
     def k_max(self, comm=None) -> float:
         """The time-step limit of the scheme's explicit terms for this mesh and data (inf: none);
-        a k above it is refused. Collective (runtime/limits.py)."""
+        a k above it is refused. Collective (problem/limits.py)."""
         from damage_dolfinx.problem.limits import k_max
         return k_max(self, comm) if comm is not None else k_max(self)
 

@@ -59,10 +59,10 @@ class Steps:
     """The steps of one prepared run (``Run.prepare``): iterate over it, or use it as a
     context manager around the loop (see the module's docstring)."""
 
-    def __init__(self, run, comm):
+    def __init__(self, run, comm, within=None):
         self._run, self._comm = run, comm
         run.handshake = True
-        self._steps = run.steps()
+        self._steps = run.steps() if within is None else within(run.steps())
         self._outcome = None
 
     # -- the iterator

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from damage_dolfinx.viz import post
+from damage_dolfinx.viz.figstyle import styled
 
 def fitted_rates(rows, ns, ks, key="error") -> dict:
     """Observed orders of ``key``: in h + k over all cells and over the diagonal (n, k) pairs,
@@ -58,6 +59,7 @@ def write_tables(out, rows, ns, ks, rates, rates_T, example_id, ref_n, ref_k, de
 COLUMN_WIDTH_IN, PLOT_HEIGHT_IN = 3.46, 2.9
 
 
+@styled
 def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="error",
                      title=None):
     """log-log error against h + k for a journal column: one line per time step, a tick and a

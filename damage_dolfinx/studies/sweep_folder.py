@@ -273,6 +273,11 @@ def plot_sweep(path, rows, grid, scalar, label):
     """``scalar`` against the first swept parameter with several values, one line per
     combination of the others."""
     from damage_dolfinx.viz import figstyle
+    return figstyle.styled(_plot_sweep)(path, rows, grid, scalar, label)
+
+
+def _plot_sweep(path, rows, grid, scalar, label):
+    from damage_dolfinx.viz import figstyle
     names = list(grid)
     x_name = next((name for name in names if len(grid[name]) > 1), names[0])
     others = [name for name in names if name != x_name]

@@ -46,14 +46,79 @@ STRESS_CMAP = "inferno"
 DAMAGE_LABEL = "$\\zeta$ (1 = sound,\n$\\zeta^*$ = fully damaged)"
 
 
+#: the style of every figure, applied inside :func:`styled` (matplotlib.rc_context), never to
+#: the global rcParams (laid out as saved: text extents measured once)
+STYLE = {"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
+         "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False, "figure.dpi": DPI}
+
+
 # ---------------------------------------------------------------------------- drawing
+def styled(draw):
+    """``draw`` (a function that makes and saves figures) run inside the style
+    (``matplotlib.rc_context(STYLE)``): the user's rcParams and backend are untouched."""
+    import functools
+
+    @functools.wraps(draw)
+    def run(*args, **kwargs):
+        import matplotlib
+        with matplotlib.rc_context(STYLE):
+            return draw(*args, **kwargs)
+    return run
+
+
+class _Figures:
+    """The part of pyplot the package uses, without pyplot: figures are
+    ``matplotlib.figure.Figure`` objects on their own Agg canvas (no backend is selected, no
+    figure manager keeps them, the user's open figures and backend stay as they are)."""
+
+    _SUBPLOT_KEYS = ("sharex", "sharey", "squeeze", "width_ratios", "height_ratios",
+                     "subplot_kw", "gridspec_kw")
+
+    @staticmethod
+    def figure(**kwargs):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+        fig = Figure(**kwargs)
+        FigureCanvasAgg(fig)
+        return fig
+
+    def subplots(self, nrows=1, ncols=1, **kwargs):
+        sub = {key: kwargs.pop(key) for key in self._SUBPLOT_KEYS if key in kwargs}
+        fig = self.figure(**kwargs)
+        return fig, fig.subplots(nrows, ncols, **sub)
+
+    @staticmethod
+    def close(fig):
+        fig.clear()
+
+    @staticmethod
+    def get_cmap(name):
+        import matplotlib
+        return matplotlib.colormaps[name] if hasattr(matplotlib, "colormaps") else \
+            matplotlib.cm.get_cmap(name)
+
+    @property
+    def rcParams(self):  # noqa: N802 (pyplot's name) - the values in force (the style inside styled)
+        import matplotlib
+        return matplotlib.rcParams
+
+
+_FIGURES = _Figures()
+
+
 def plt():
+    """Figures without pyplot (:class:`_Figures`: ``subplots``, ``figure``, ``close``,
+    ``get_cmap``); draw inside :func:`styled` for the package's style."""
+    return _FIGURES
+
+
+def pyplot_styled():
+    """For an application script (the reproduction, the benchmarks), not the library: pyplot
+    on the Agg backend with the style in the global rcParams."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as pyplot
-    pyplot.rcParams.update({"font.size": 9, "axes.titlesize": 9.5, "figure.titlesize": 10.5,
-                            "mathtext.fontset": "dejavusans", "axes.formatter.useoffset": False,
-                            "figure.dpi": DPI})  # laid out as saved: text extents computed once
+    pyplot.rcParams.update(STYLE)
     return pyplot
 
 
@@ -63,6 +128,7 @@ def ticker():
     return matplotlib.ticker
 
 
+@styled
 def save_as_laid_out(fig, path, dpi=300):
     """Save a figure whose layout and title its caller set (tight bounding box), and close it."""
     fig.savefig(path, dpi=dpi, bbox_inches="tight", **fastdraw.png_options(path))
@@ -76,6 +142,7 @@ def data_aspect(xy) -> float:
     return float(np.clip(h / w if w > 0 else 1.0, 0.25, 2.5))
 
 
+@styled
 def new_figure(npanels: int, aspect: float, panel_width: float = 4.2):
     """Figure with ``npanels`` side-by-side axes of the body's aspect ratio (no empty bands)."""
     pyplot = plt()
@@ -112,6 +179,7 @@ def _frame(ax, xy_list):
     ax.set_ylabel(r"$x_2$ [m]")
 
 
+@styled
 def render_fields(panels, path, title="", amplification=1.0, ref_xy=None, zeta_star=None,
                   mesh_only=False, limits=None, guides=None):
     """Draw the panels of one figure. ``panels``: list of dicts with ``xy`` (nc, 3, 2) deformed
@@ -250,6 +318,7 @@ def _tight(fig):
     return fastdraw.tight_bbox(fig, plt().rcParams["savefig.pad_inches"])
 
 
+@styled
 def save(fig, path, title=None):
     fig.tight_layout()
     if title:

@@ -19,6 +19,7 @@ import numpy as np
 from mpi4py import MPI
 
 from damage_dolfinx.viz import figstyle
+from damage_dolfinx.viz.figstyle import styled
 
 
 def vault_summary(stepper) -> dict:
@@ -58,6 +59,7 @@ def face_maps(stepper):  # called by problems/bridge_2_1.py at collapse (3-D)
     return maps
 
 
+@styled
 def plot_hinge_lines(summary, path, title=""):
     """The figure of the module docstring from a run's summary.json (rank 0 only)."""
     vault, bridge = summary["vault"], summary["bridge"]
@@ -112,6 +114,7 @@ def plot_hinge_lines(summary, path, title=""):
     figstyle.save(fig, path, title=title)
 
 
+@styled
 def draw_figure(stepper, fig, path):
     """A catalogue figure of kind "problem" of the bridge stepper (collective; rank 0 draws):
     fig.fields[0] is "hinge_lines" (3-D, at collapse) or "load_displacement" (P against the
@@ -144,6 +147,7 @@ def read_curve(history_csv):
             np.array([-1e3 * float(r["u_load_y"]) for r in rows]))
 
 
+@styled
 def plot_load_displacement(history_csv, failure_kN, path, title="", reference=None,
                            label="this run"):
     """P against the downward displacement; ``reference`` = (history_csv, failure_kN, label)

@@ -9,6 +9,7 @@ from mpi4py import MPI
 
 from damage_dolfinx import compat
 from damage_dolfinx.forms.constitutive import eps
+from damage_dolfinx.viz.figstyle import styled
 
 
 # ---------------------------------------------------------------------------- nested transfer
@@ -222,6 +223,7 @@ def _run_zeta_star(png_path):
         return None
 
 
+@styled
 def plot_mesh(geometry, path, title="", labels=None, loads=None, split=None):
     """The undeformed mesh with its tagged boundary parts (thesis 'setting' figures): Gamma_D
     with clamp hatching, Gamma_C with the foundation drawn under it, load arrows (``loads``
@@ -361,6 +363,7 @@ def loglog_rate(x, y):
     return float(np.polyfit(np.log(x[ok]), np.log(y[ok]), 1)[0])
 
 
+@styled
 def plot_history(csv_path, columns, path, title=""):
     """Time histories of history.csv columns, one axis each (rank 0 only)."""
     import csv
@@ -383,6 +386,7 @@ def plot_history(csv_path, columns, path, title=""):
     figstyle.save(fig, path, title=figstyle.mathtext(title))
 
 
+@styled
 def plot_damage_profiles(prof, history_csv, zeta_star, path, title, probe_column="zeta_probe",
                          probe_label="zeta(0, 6)"):
     """Thesis Figures 3.17/3.18: zeta along a line at several times (``prof`` = the stepper's

@@ -13,6 +13,7 @@ from mpi4py import MPI
 
 from damage_dolfinx import compat
 from damage_dolfinx.viz import figstyle
+from damage_dolfinx.viz.figstyle import styled
 
 #: sample points per side of a section
 RESOLUTION = 161
@@ -75,6 +76,7 @@ def _bounds(msh):
     return lo, hi
 
 
+@styled
 def plot_slices(fields, path, title="", zeta_star=0.01, planes=None, msh=None):
     """PNG of ``fields`` [(Function, label), ...] (rows) on ``planes`` [(axis, value), ...]
     (columns). Collective; rank 0 draws. Returns the planes drawn."""
