@@ -15,11 +15,15 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from damage_dolfinx.parameters import InputError
+
+#: the smallest normal double: a nonzero number below it has lost its precision (underflow)
+TINY = sys.float_info.min
 
 #: the largest sweep grid (points); larger grids are refused before any work
 MAX_SWEEP_POINTS = 10000
@@ -47,6 +51,9 @@ def real(name, value, *, low=None, high=None, low_open=False, allow_none=False,
     v = float(value)
     if not math.isfinite(v):
         raise InputError(f"{name} must be a finite number, got {v}")
+    if 0.0 < abs(v) < TINY:
+        raise InputError(f"{name} = {v:g} underflows (below {TINY:.3g}, the smallest normal "
+                         "number): no time, size or datum is that small")
     if low is not None and (v <= low if low_open else v < low):
         raise InputError(f"{name} must be {'>' if low_open else '>='} {low:g}, got {v:g}")
     if high is not None and v > high:
@@ -171,6 +178,12 @@ ARGUMENTS = {
 }
 
 
+#: the defaults of the public entries (run, steps, converge, sweep) and of the command line's
+#: options of the same name, in one place: nothing written earlier is replaced unless asked
+DEFAULTS = {"restart": False, "overwrite": False, "progress": True, "figures": True,
+            "checkpoint_every": None}
+
+
 def arguments(**given) -> dict:
     """``given`` with each value checked (and normalised: NumPy scalars to Python) by the rule
     of its name in ARGUMENTS; InputError naming the first argument that fails."""
@@ -186,7 +199,7 @@ def check_run(n=None, k=None, T=None, restart=False, overwrite=False, checkpoint
                      on_step=on_step, **extra)
 
 
-def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True, progress=True,
+def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=False, progress=True,
                    out=None, comm=None):
     """The levels of converge(): lists of whole n and positive k, the reference's, T, and its
     flags (its folder and communicator when given)."""
@@ -241,3 +254,40 @@ def cell_types_problem(gmsh, d):
         return (f"it mixes cell types ({', '.join(names)}); a mesh needs one cell type "
                 "(gmsh: Mesh.RecombineAll 0 for triangles, or recombine every surface)")
     return None
+
+
+def limit(name, value, source="") -> float:
+    """A stability limit (k_max) a model or a cache gives: a positive number or math.inf (no
+    limit); NaN, a negative number, zero or a non-number is the model's error, refused (a NaN
+    limit would let every k through: k > NaN is False)."""
+    where = f" ({source})" if source else ""
+    if not is_real(value):
+        raise InputError(f"{name}{where} must be a number, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    v = float(value)
+    if math.isnan(v) or v <= 0 or (0 < v < TINY):
+        raise InputError(f"{name}{where} must be a positive number or inf (no limit), got {v}: "
+                         "the stability limit cannot be checked")
+    return v
+
+
+def number_like(old, value, key):
+    """A parameter's new value of the type of its default: a bool is not a number and a number
+    not a bool (E=True would run with E = 1); a number is finite (inf only where meaningful)
+    and does not underflow. Strings are read by parameters._coerce."""
+    from damage_dolfinx.parameters import INFINITE_ALLOWED
+    if isinstance(old, bool) and is_real(value):
+        raise InputError(f"parameter {key} is a flag (True or False), got {_shown(value)}")
+    if is_real(old) and isinstance(value, (bool, np.bool_)):
+        raise InputError(f"parameter {key} is a number, got {value!r} (a bool is not a number)")
+    if is_real(old) and value is not None and not isinstance(value, str) and \
+            not is_real(value) and not callable(value):
+        raise InputError(f"parameter {key} is a number, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    if is_real(value):
+        v = float(value)
+        if math.isnan(v) or (math.isinf(v) and key not in INFINITE_ALLOWED):
+            raise InputError(f"parameter {key} must be a finite number, got {v}")
+        if 0.0 < abs(v) < TINY:
+            raise InputError(f"parameter {key} = {v:g} underflows (below {TINY:.3g})")
+    return value

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from mpi4py import MPI
 
+from damage_dolfinx.validation import DEFAULTS as _D
+
 
 def _named(problem):
     """A catalogue id needs the catalogue loaded (it registers its ids with the run machinery,
@@ -13,8 +15,9 @@ def _named(problem):
     return problem
 
 
-def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-        checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD,
+def run(problem, out, *, n=None, k=None, T=None, restart=_D["restart"],
+        overwrite=_D["overwrite"], checkpoint_every=_D["checkpoint_every"],
+        progress=_D["progress"], figures=_D["figures"], comm=MPI.COMM_WORLD,
         on_step=None) -> dict:
     """Run ``problem`` (a :class:`~damage_dolfinx.Problem`, or a catalogue id such as
     ``"2.2-ex1"``) and write its run folder ``out``; returns the summary (also in
@@ -60,8 +63,9 @@ def run(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
                     comm=comm, on_step=on_step)
 
 
-def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=False,
-          checkpoint_every=None, progress=True, figures=True, comm=MPI.COMM_WORLD):
+def steps(problem, out, *, n=None, k=None, T=None, restart=_D["restart"],
+          overwrite=_D["overwrite"], checkpoint_every=_D["checkpoint_every"],
+          progress=_D["progress"], figures=_D["figures"], comm=MPI.COMM_WORLD):
     """The run of :func:`run` (the same arguments, the same run folder), step by step::
 
         with dd.steps(problem, "results/mine") as run:
@@ -105,8 +109,8 @@ def steps(problem, out, *, n=None, k=None, T=None, restart=False, overwrite=Fals
     return Steps(run, comm)
 
 
-def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart=False,
-             overwrite=True, comm=MPI.COMM_WORLD) -> dict:
+def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=_D["progress"],
+             restart=_D["restart"], overwrite=_D["overwrite"], comm=MPI.COMM_WORLD) -> dict:
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
     run at (``ref_n``, ``ref_k``), with fitted rates; writes ``out/convergence.json``, tables
     and a plot, and returns the summary. The problem's mesh must be a family ``(comm, n) ->
@@ -121,7 +125,8 @@ def converge(problem, out, *, n, k, ref_n, ref_k, T=None, progress=True, restart
     holding a study: nothing to do when it completed with these settings, else it runs again
     (studies keep no checkpoints); a study whose settings or run fingerprint at any level (mesh,
     loads, law, ... as a run's restart checks) differ is refused, naming what changed.
-    ``overwrite=False`` refuses a folder that holds a study."""
+    A folder that holds a study is refused unless ``restart`` or ``overwrite`` (the defaults
+    of every entry, the command line's included: validation.DEFAULTS)."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.studies.convergence import study
     from damage_dolfinx.validation import check_converge, communicator

@@ -106,3 +106,14 @@ def _load_plugins():
         except ImportError as exc:
             raise InputError(f"DAMAGE_DOLFINX_PLUGINS names {name!r}, which cannot be "
                              f"imported: {exc}") from None
+        except SystemExit as exc:  # a plugin may not end the command (exit 0, no run)
+            raise InputError(f"plugin {name!r} (DAMAGE_DOLFINX_PLUGINS) called "
+                             f"sys.exit({exc.code!r}) while being imported: the plugin "
+                             "failed") from None
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # noqa: BLE001 - the plugin's failure, one line
+            text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+            raise InputError(f"plugin {name!r} (DAMAGE_DOLFINX_PLUGINS) failed while being "
+                             f"imported: {type(exc).__name__}"
+                             + (f": {text}" if text else "")) from None

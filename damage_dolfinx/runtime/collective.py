@@ -230,6 +230,7 @@ def outcome(comm=MPI.COMM_WORLD):
         try:
             yield
         except BaseException as exc:
+            _taken(exc)
             if comm.size == 1 and _LOCAL.depth == 1:
                 for folder, kind in _FOLDERS[start:]:
                     mark(folder, exc, kind=kind)
@@ -248,6 +249,7 @@ def outcome(comm=MPI.COMM_WORLD):
     try:
         yield
     except BaseException as exc:  # noqa: BLE001 - every exception is decided collectively
+        _taken(exc)
         failure = exc
     finally:
         _LOCAL.depth = 0
@@ -278,6 +280,14 @@ def outcome(comm=MPI.COMM_WORLD):
         raise failure  # this rank's own exception is of the decided kind: the caller's catch
     raise decided(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,
                   kind) from failure
+
+
+def _taken(exc):
+    """A stop signal's exception reached the call: it is not delivered again
+    (signals.stop_outside_runs)."""
+    if isinstance(exc, KeyboardInterrupt):
+        from damage_dolfinx.runtime.signals import taken
+        taken()
 
 
 def decided(text, code, kind) -> RankFailure:

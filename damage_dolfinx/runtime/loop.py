@@ -223,13 +223,13 @@ class Run(RunRecords):
             try:
                 yield Step(self)
             except GeneratorExit:
-                if self.abandoned or not together(self, leaving=True):
+                if not together(self, 2 if self.abandoned else 1) or self.abandoned:
                     raise
                 stop = "stopped"
                 if stepper.n < N and self.supported:
                     self.save_checkpoint()
             else:
-                together(self, leaving=False)
+                together(self, 0)
             while stop is None and stepper.n < N:
                 stop, step = self._step()
                 if stop:
@@ -237,12 +237,12 @@ class Run(RunRecords):
                 try:  # here, not in _step: a close reaches a nested generator's caller too
                     yield Step(self)
                 except GeneratorExit:  # the caller stopped here: the outputs of a stop
-                    if self.abandoned or not together(self, leaving=True):
+                    if not together(self, 2 if self.abandoned else 1) or self.abandoned:
                         raise
                     self._outputs("stopped", *step)
                     stop = "stopped"
                 else:
-                    together(self, leaving=False)
+                    together(self, 0)
             self._finish(stop)
         except (ConvergenceError, io.OutputError) as exc:
             self._failed(exc)
