@@ -291,3 +291,56 @@ def number_like(old, value, key):
         if 0.0 < abs(v) < TINY:
             raise InputError(f"parameter {key} = {v:g} underflows (below {TINY:.3g})")
     return value
+
+
+def claims_problem(gmsh, d):
+    """What a gmsh model of dimension ``d`` claims and does not hold (rank 0; None: nothing):
+
+    * its nodes span only ``d`` coordinates: a 2-D mesh lies in the x-y plane (one in the x-z
+      plane would be read as a degenerate 2-D mesh, its y all equal);
+    * every cell belongs to a physical group of dimension ``d`` (an untagged cell is left out
+      of the mesh DOLFINx builds, or crashes PETSc);
+    * the cells are first order (the package's spaces and outputs are of linear geometry)."""
+    _, coords, _ = gmsh.model.mesh.getNodes()
+    xyz = np.asarray(coords, dtype=float).reshape(-1, 3)
+    if len(xyz):
+        span = xyz.max(axis=0) - xyz.min(axis=0)
+        scale = max(float(span.max()), 1e-300)
+        if d == 2 and span[2] > 1e-10 * scale:
+            flat = [("x", "y", "z")[i] for i in range(3) if span[i] <= 1e-10 * scale]
+            where = f" (its {flat[0]} is constant: the {'-'.join(a for a in 'xyz' if a not in flat)} plane)" \
+                if flat else ""
+            return (f"it is a 2-D mesh whose nodes span z as well{where}: a 2-D problem is in "
+                    "the x-y plane (rotate the geometry there, or mesh it in 3-D)")
+        if d == 2 and span[0] <= 1e-10 * scale or d == 2 and span[1] <= 1e-10 * scale:
+            return "it is a 2-D mesh whose nodes lie on one line (no area)"
+    for t in gmsh.model.mesh.getElementTypes(d):
+        name, _, order = gmsh.model.mesh.getElementProperties(t)[:3]
+        if order != 1:
+            return (f"its cells are of order {order} ({name}); only first-order cells are "
+                    "supported (gmsh: Mesh.ElementOrder 1)")
+    tagged = {tag for _, group in gmsh.model.getPhysicalGroups(d)
+              for tag in gmsh.model.getEntitiesForPhysicalGroup(d, group)}
+    untagged, total = 0, 0
+    for _, entity in gmsh.model.getEntities(d):
+        count = sum(len(e) for e in gmsh.model.mesh.getElements(d, entity)[1])
+        total += count
+        if entity not in tagged:
+            untagged += count
+    cell_nodes = np.unique(np.concatenate([np.asarray(n, dtype=np.int64) for n in
+                                           gmsh.model.mesh.getElements(d)[2]] or [[]]))
+    loose = 0
+    for _, group in gmsh.model.getPhysicalGroups(d - 1):
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(d - 1, group):
+            for nodes in gmsh.model.mesh.getElements(d - 1, entity)[2]:
+                loose += int(np.sum(~np.isin(np.asarray(nodes, dtype=np.int64), cell_nodes)))
+    if loose:
+        return (f"tagged boundary facets have {loose} node(s) of no cell: cells were left out "
+                f"(a {'surface' if d == 2 else 'volume'} in no physical group is not saved); "
+                f"tag every cell (gmsh: Physical {'Surface' if d == 2 else 'Volume'} over "
+                f"every {'surface' if d == 2 else 'volume'})")
+    if untagged:
+        return (f"{untagged} of its {total} cells belong to no physical "
+                f"{'surface' if d == 2 else 'volume'}: tag every cell (gmsh: Physical "
+                f"{'Surface' if d == 2 else 'Volume'} over every {'surface' if d == 2 else 'volume'})")
+    return None
