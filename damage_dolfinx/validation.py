@@ -280,8 +280,8 @@ def number_like(old, value, key):
         raise InputError(f"parameter {key} is a flag (True or False), got {_shown(value)}")
     if is_real(old) and isinstance(value, (bool, np.bool_)):
         raise InputError(f"parameter {key} is a number, got {value!r} (a bool is not a number)")
-    if is_real(old) and value is not None and not isinstance(value, str) and \
-            not is_real(value) and not callable(value):
+    if is_real(old) and not isinstance(value, str) and not is_real(value) and \
+            not callable(value):
         raise InputError(f"parameter {key} is a number, got {_shown(value)} "
                          f"({type(value).__name__})")
     if is_real(value):

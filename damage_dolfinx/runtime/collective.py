@@ -263,9 +263,9 @@ def outcome(comm=MPI.COMM_WORLD):
             _abort(comm, failure, folders)
         time.sleep(0.002)
     outcomes = agree.allgather(mine)
-    agree.Free()
     failed = [o for o in outcomes if o is not None]
     if not failed:
+        agree.Free()
         _CREATED.clear()
         return
     rank, code, kind, text = failed[0]
@@ -276,6 +276,8 @@ def outcome(comm=MPI.COMM_WORLD):
         exc = failure if failure is not None else RankFailure(text, code, kind)
         for folder, where in folders:
             mark(folder, exc, alone, where)
+    agree.Barrier()  # the status is on disk before any rank's caller sees the exception
+    agree.Free()
     if failure is not None and (rank == comm.rank or classify(failure)[:2] == (code, kind)):
         raise failure  # this rank's own exception is of the decided kind: the caller's catch
     raise decided(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,

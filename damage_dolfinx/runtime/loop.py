@@ -71,11 +71,14 @@ class Run(RunRecords):
     #: under MPI: runtime/steps.together)
     handshake = False
 
-    def abandon(self, steps):
+    def abandon(self, steps, tell=False):
         """End the generator ``steps`` after the caller's own code raised inside the loop: no
         outputs of a stop (a rank alone in this may not enter a collective write while the
-        others solve; the exception decides the status, runtime/collective.py)."""
-        self.abandoned = True
+        others solve; the exception decides the status, runtime/collective.py). ``tell``: the
+        other ranks learn it at their next hand-over (dd.steps at the script's end: they raise
+        LoopLeft); otherwise no collective call at all (the call's outcome decides, or ends
+        the job)."""
+        self.abandoned = "told" if tell else "alone"
         steps.close()
 
     def steps(self):
@@ -223,7 +226,8 @@ class Run(RunRecords):
             try:
                 yield Step(self)
             except GeneratorExit:
-                if not together(self, 2 if self.abandoned else 1) or self.abandoned:
+                if self.abandoned == "alone" or not together(
+                        self, 2 if self.abandoned else 1) or self.abandoned:
                     raise
                 stop = "stopped"
                 if stepper.n < N and self.supported:
@@ -237,7 +241,8 @@ class Run(RunRecords):
                 try:  # here, not in _step: a close reaches a nested generator's caller too
                     yield Step(self)
                 except GeneratorExit:  # the caller stopped here: the outputs of a stop
-                    if not together(self, 2 if self.abandoned else 1) or self.abandoned:
+                    if self.abandoned == "alone" or not together(
+                        self, 2 if self.abandoned else 1) or self.abandoned:
                         raise
                     self._outputs("stopped", *step)
                     stop = "stopped"

@@ -32,7 +32,7 @@ class LoopLeft(RuntimeError):
 
 
 #: what a rank says after each hand-over: its caller goes on, left the loop (a stop), or
-#: raised inside the loop (the ``with`` form: the run is abandoned, no collective output)
+#: raised inside the loop (the script ended on an uncaught exception: the run is abandoned)
 GOING_ON, LEAVING, ABANDONING = 0, 1, 2
 
 
@@ -100,7 +100,7 @@ class Steps:
             return
         if uncaught is not None:
             try:
-                self._run.abandon(self._steps)
+                self._run.abandon(self._steps, tell=True)
             finally:
                 from damage_dolfinx.runtime.collective import mark
                 if self._comm.rank == 0:
