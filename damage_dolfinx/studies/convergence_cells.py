@@ -190,14 +190,16 @@ def check_family(ref, ref_n, runs, comm):
     ns = sorted(levels)
     for a, b in zip(ns, ns[1:]):
         if not levels[b][0] < levels[a][0] * (1 - 1e-9):
-            raise InputError(f"the mesh family does not refine as n grows: h = "
+            raise InputError(f"the meshes of this family cannot be compared: they do not "
+                             f"refine as n grows, h = "
                              f"{levels[a][0]:.6g} at n = {a} and h = {levels[b][0]:.6g} at "
                              f"n = {b} (a family (comm, n) -> mesh must be finer at a larger n)")
     h_ref, lo_ref, hi_ref = ref_box
     for n in ns:
         h, lo, hi = levels[n]
         if max(np.abs(lo - lo_ref).max(), np.abs(hi - hi_ref).max()) > 0.5 * h + 1e-12:
-            raise InputError(f"the meshes of this family do not cover one domain: n = {n} spans "
+            raise InputError(f"the meshes of this family cannot be compared: they do not cover "
+                             f"one domain, n = {n} spans "
                              f"{np.round(lo, 6).tolist()}-{np.round(hi, 6).tolist()}, the "
                              f"reference n = {ref_n} {np.round(lo_ref, 6).tolist()}-"
                              f"{np.round(hi_ref, 6).tolist()}")
