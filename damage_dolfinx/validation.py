@@ -308,8 +308,8 @@ def claims_problem(gmsh, d):
         scale = max(float(span.max()), 1e-300)
         if d == 2 and span[2] > 1e-10 * scale:
             flat = [("x", "y", "z")[i] for i in range(3) if span[i] <= 1e-10 * scale]
-            where = f" (its {flat[0]} is constant: the {'-'.join(a for a in 'xyz' if a not in flat)} plane)" \
-                if flat else ""
+            plane = "-".join(a for a in "xyz" if a not in flat)
+            where = f" (its {flat[0]} is constant: the {plane} plane)" if flat else ""
             return (f"it is a 2-D mesh whose nodes span z as well{where}: a 2-D problem is in "
                     "the x-y plane (rotate the geometry there, or mesh it in 3-D)")
         if d == 2 and span[0] <= 1e-10 * scale or d == 2 and span[1] <= 1e-10 * scale:
@@ -340,7 +340,7 @@ def claims_problem(gmsh, d):
                 f"tag every cell (gmsh: Physical {'Surface' if d == 2 else 'Volume'} over "
                 f"every {'surface' if d == 2 else 'volume'})")
     if untagged:
-        return (f"{untagged} of its {total} cells belong to no physical "
-                f"{'surface' if d == 2 else 'volume'}: tag every cell (gmsh: Physical "
-                f"{'Surface' if d == 2 else 'Volume'} over every {'surface' if d == 2 else 'volume'})")
+        part = "surface" if d == 2 else "volume"
+        return (f"{untagged} of its {total} cells belong to no physical {part}: tag every cell "
+                f"(gmsh: Physical {part.capitalize()} over every {part})")
     return None

@@ -32,7 +32,8 @@ from damage_dolfinx.studies.convergence_tables import (fitted_rates, plot_conver
                                                       write_tables)
 from damage_dolfinx.numerics.solvers import ConvergenceError
 from damage_dolfinx.studies.convergence_cells import (  # noqa: F401 (SERIAL_CELL_MAX_N)
-    SERIAL_CELL_MAX_N, _CoarseRun, _Transfers, _cell_geometry, check_family, _check_states, _component_norms,
+    SERIAL_CELL_MAX_N, _CoarseRun, _Transfers, _cell_geometry, _check_states, _component_norms,
+    check_family,
     _error_definition, _norm_statement, _owners)
 
 from damage_dolfinx.studies.convergence_resume import (SCHEMA, check_restart, level_fingerprints,
