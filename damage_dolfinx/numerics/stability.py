@@ -327,9 +327,9 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
                 if wrong:
                     if comm.rank == 0:
                         import sys
-                        print(f"WARNING: the stored stability limit "
-                              f"({stability_cache.directory()}/{key}.json) is not used: "
-                              f"{wrong}; it is eigensolved again", file=sys.stderr, flush=True)
+                        print(f"WARNING: the stored stability limit {key[:12]} (the stability "
+                              f"cache, {stability_cache.ENV}) is not used: {wrong}; it is "
+                              "eigensolved again", file=sys.stderr, flush=True)
                     exact = None
                 else:
                     stability_bound.store(key, exact)
