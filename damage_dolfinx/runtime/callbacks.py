@@ -6,9 +6,10 @@ Mechanism (:func:`decide`): the callback runs on every rank; its outcome (stop o
 the exception it raised) is exchanged in one allgather of a small tuple on the run's
 communicator, which every rank reaches after the same step. Then
 
-* an exception on any rank ends the call on every rank: the raising rank re-raises its own
-  exception, the others raise :class:`CallbackFailed` naming the rank and the error (the
-  status "failed" goes into summary.json, runtime/collective.py);
+* an exception on some ranks only ends the call on every rank with the same exception,
+  :class:`CallbackFailed` naming the first raising rank and its error (the user's exception
+  is its ``__cause__`` where it was raised; the status "failed" goes into summary.json,
+  runtime/collective.py); an exception on every rank is re-raised as it is, as on one rank;
 * a stop (a true return value) asked on any rank stops every rank at that step (status
   "stopped", with its outputs and a checkpoint); when only some ranks asked, one warning line
   names them.
@@ -66,11 +67,12 @@ def decide(comm, callback, *args, name="on_step", step=None) -> bool:
     everyone = comm.allgather(mine)
     failed = [(rank, text) for rank, (_, text) in enumerate(everyone) if text is not None]
     if failed:
-        if error is not None:
+        if error is not None and len(failed) == comm.size:  # alike everywhere: as on one rank
             raise error
         rank, text = failed[0]
         raise CallbackFailed(f"{name} raised on rank {rank}" +
-                             (f" at step {step}" if step is not None else "") + f": {text}")
+                             (f" at step {step}" if step is not None else "") + f": {text}") \
+            from error
     asked = [rank for rank, (flag, _) in enumerate(everyone) if flag]
     if asked and len(asked) < comm.size and comm.rank == 0:
         print(f"WARNING: {name} asked to stop on rank(s) {', '.join(map(str, asked))} only"
