@@ -798,8 +798,8 @@ def _api_in_process(code, cwd):
                                                  "CODE = _CODE"), "harness.py", "exec"),
                      {"__name__": "__main__", "_CODE": code})
                 status = 0
-            except SystemExit as exc:
-                status = exc.code
+            except SystemExit as exc:  # as the interpreter maps it: None 0, a text 1
+                status = exc.code if isinstance(exc.code, int) else int(exc.code is not None)
             except Exception:  # noqa: BLE001 - recorded as a traceback
                 err.write(traceback.format_exc())
                 status = 1

@@ -15,6 +15,7 @@ from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from mpi4py import MPI
 
+from damage_dolfinx.core.validation import DEFAULTS as _D
 from damage_dolfinx.problem.problem import Problem  # (light: no DOLFINx, for the annotations)
 from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS
 from damage_dolfinx.runtime.steps import Steps
@@ -39,9 +40,10 @@ def _petsc(petsc_options, comm, what):
 
 
 def run(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
-        k: Optional[float] = None, T: Optional[float] = None, restart: bool = False,
-        overwrite: bool = False, checkpoint_every: Optional[int] = None, progress: bool = True,
-        figures: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+        k: Optional[float] = None, T: Optional[float] = None, restart: bool = _D["restart"],
+        overwrite: bool = _D["overwrite"], checkpoint_every: Optional[int] = _D["checkpoint_every"],
+        progress: bool = _D["progress"], figures: bool = _D["figures"],
+        comm: MPI.Comm = MPI.COMM_WORLD,
         on_step: Optional[Callable[[Any], Any]] = None,
         petsc_options: PetscOptions = None, h: Optional[float] = None,
         overrides: Optional[Mapping[str, Any]] = None, mesh_file: Optional[PathLike] = None,
@@ -100,9 +102,11 @@ def run(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
 
 
 def steps(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
-          k: Optional[float] = None, T: Optional[float] = None, restart: bool = False,
-          overwrite: bool = False, checkpoint_every: Optional[int] = None,
-          progress: bool = True, figures: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+          k: Optional[float] = None, T: Optional[float] = None, restart: bool = _D["restart"],
+          overwrite: bool = _D["overwrite"],
+          checkpoint_every: Optional[int] = _D["checkpoint_every"],
+          progress: bool = _D["progress"], figures: bool = _D["figures"],
+          comm: MPI.Comm = MPI.COMM_WORLD,
           petsc_options: PetscOptions = None, h: Optional[float] = None,
           overrides: Optional[Mapping[str, Any]] = None, mesh_file: Optional[PathLike] = None,
           write_every: Optional[int] = None, checkpoint_seconds: float = CHECKPOINT_SECONDS,
@@ -170,8 +174,9 @@ def _within(steps: Iterator, scope) -> Iterator:
 
 def converge(problem: ProblemLike, out: PathLike, *, n: Optional[Sequence[int]] = None,
              k: Optional[Sequence[float]] = None, ref_n: Optional[int] = None,
-             ref_k: Optional[float] = None, T: Optional[float] = None, progress: bool = True,
-             restart: bool = False, overwrite: bool = True, comm: MPI.Comm = MPI.COMM_WORLD,
+             ref_k: Optional[float] = None, T: Optional[float] = None,
+             progress: bool = _D["progress"], restart: bool = _D["restart"],
+             overwrite: bool = _D["overwrite"], comm: MPI.Comm = MPI.COMM_WORLD,
              petsc_options: PetscOptions = None, overrides: Optional[Mapping[str, Any]] = None,
              reference_ranks: Union[int, str, None] = None) -> dict:
     """Errors of ``problem`` on the mesh levels ``n`` and time steps ``k`` against a reference
@@ -188,7 +193,8 @@ def converge(problem: ProblemLike, out: PathLike, *, n: Optional[Sequence[int]] 
     holding a study: nothing to do when it completed with these settings, else it runs again
     (studies keep no checkpoints); a study whose settings or run fingerprint at any level (mesh,
     loads, law, ... as a run's restart checks) differ is refused, naming what changed.
-    ``overwrite=False`` refuses a folder that holds a study. ``petsc_options``: PETSc options of
+    A folder that holds a study is refused unless ``restart`` or ``overwrite`` (the defaults
+    of every entry, the command line's included: core.validation.DEFAULTS). ``petsc_options``: PETSc options of
     every run of the study (the module's docstring). ``n``, ``k``, ``ref_n``, ``ref_k`` left
     None take a catalogue example's default study (a problem of your own has none: give them).
     ``overrides``: changes to the problem's data, as for :func:`run`; ``reference_ranks``: 1

@@ -20,7 +20,28 @@ MPI every rank ends with the same status, also when only one rank failed
 from __future__ import annotations
 
 import os
+import signal as _signal
 import sys
+
+#: a stop signal that came while the command was starting (before main() set its handlers):
+#: main() then stops at once with the one line and the exit status 128 + signal
+_EARLY = []
+
+
+def _early(signum, frame):
+    _EARLY.append(signum)
+
+
+#: started as the command (python -m damage_dolfinx.cli, the damage-dolfinx script), not
+#: imported by a program of its own (whose signal handlers stay as they are)
+_AS_COMMAND = sys.argv[:1] == ["-m"] or os.path.basename(sys.argv[0] if sys.argv else "") in (
+    "damage-dolfinx", "__main__.py")
+try:  # from the first moment: no stop signal kills the command without a line
+    for _s in (_signal.SIGTERM, _signal.SIGINT, _signal.SIGUSR1) if _AS_COMMAND else ():
+        if _signal.getsignal(_s) in (_signal.SIG_DFL, _signal.default_int_handler):
+            _signal.signal(_s, _early)
+except ValueError:  # not the main thread
+    pass
 
 #: set by an MPI launcher (Open MPI's mpirun, PMIx, PMI: MPICH's hydra, Slurm's srun) in the
 #: environment of the processes it starts
@@ -71,16 +92,24 @@ def main(argv=None):
     given = {}
     before = {}
     try:
-        for s in (signal.SIGTERM, signal.SIGINT):  # the run's loop has its own (StopSignals)
-            before[s] = signal.signal(s, stop_outside_runs)
+        for s in (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1):  # the run's loop has its own
+            before[s] = signal.signal(s, stop_outside_runs)        # (StopSignals)
     except ValueError:  # not the main thread
         pass
     try:
         return _main(argv, comm, given)
     finally:
+        from damage_dolfinx.runtime.signals import taken
+        taken()
         for s, handler in before.items():
             if signal.getsignal(s) is stop_outside_runs:  # (an interruption leaves SIG_IGN)
                 signal.signal(s, handler)
+        if _AS_COMMAND:  # the command has ended, its status written: a stop signal now (while
+            try:         # Python, MPI and PETSc shut down, which put back the default
+                for s in (signal.SIGTERM, signal.SIGINT, signal.SIGUSR1):  # actions) changes
+                    signal.signal(s, signal.SIG_IGN)                         # nothing
+            except (ValueError, OSError):
+                pass
 
 
 def _main(argv, comm, given):
@@ -90,6 +119,10 @@ def _main(argv, comm, given):
     try:
         with collective.outcome(comm):
             try:
+                if _EARLY:  # a stop signal while the command was starting
+                    from damage_dolfinx.runtime.signals import RECEIVED, SignalStop
+                    RECEIVED["signum"] = RECEIVED["signum"] or _EARLY[0]
+                    raise SignalStop(_EARLY.pop(0))
                 return command(argv, comm, given)
             finally:
                 _forget(given)
@@ -103,6 +136,8 @@ def _main(argv, comm, given):
         return 4
     except (RunInterrupted, KeyboardInterrupt, collective.RankFailure) as exc:
         import signal
+        from damage_dolfinx.runtime.signals import taken
+        taken()
         from damage_dolfinx.runtime.signals import STOP_SIGNALS
         if not isinstance(exc, collective.RankFailure) or exc.kind == "":
             for s in STOP_SIGNALS:  # the request arriving twice must not kill us on the way out

@@ -143,6 +143,10 @@ def _parser():
     conv.add_argument("--overwrite", action="store_true",
                       help="replace a study already in --out: the files its manifest.json lists")
     _sweep_parser(sub)
+    from damage_dolfinx.core.validation import DEFAULTS  # the API's defaults, in one place
+    for sp in (run, conv):
+        sp.set_defaults(restart=DEFAULTS["restart"], overwrite=DEFAULTS["overwrite"],
+                        checkpoint_every=DEFAULTS["checkpoint_every"])
     return p
 
 
@@ -199,19 +203,36 @@ def _overrides(pairs, friction_solver=None, friction_law=None, reading=None, arg
         out["friction_law"] = friction_law
     if reading is not None:
         out["reading"] = reading
+    given = set()
     for pair in pairs:
         if "=" not in pair:
             raise InputError(f"--set expects NAME=VALUE, got {pair!r}")
-        name, value = pair.split("=", 1)
-        out[name.strip()] = value.strip()
+        name, value = (part.strip() for part in pair.split("=", 1))
+        if not name:
+            raise InputError(f"--set {pair!r}: no parameter name")
+        if name in given or (name in out and name in _SAME_AS_SET):
+            raise InputError(f"--set {name}: the parameter is given twice (once is enough; "
+                             "which one was meant is not clear)")
+        given.add(name)
+        out[name] = value
     return out
+
+
+#: parameters that an option of their own also sets (--friction-solver, --friction-law,
+#: --reading): given there and by --set as well is given twice
+_SAME_AS_SET = frozenset({"friction_solver", "friction_law", "reading"})
 
 
 def _check_finite(args):
     """Every number on the command line is finite (argparse's float() accepts 'inf' and 'nan')."""
     import math
+    import sys
     from damage_dolfinx.core.parameters import InputError
     for name, value in vars(args).items():
         for v in value if isinstance(value, list) else [value]:
             if isinstance(v, float) and not math.isfinite(v):
                 raise InputError(f"--{name.replace('_', '-')} must be a finite number, got {v}")
+            if isinstance(v, float) and 0 < abs(v) < sys.float_info.min:
+                raise InputError(f"--{name.replace('_', '-')} = {v:g} underflows (below "
+                                 f"{sys.float_info.min:.3g}, the smallest normal number): a "
+                                 "time or a size cannot be that small")

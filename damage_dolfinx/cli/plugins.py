@@ -21,9 +21,24 @@ def names(given=()) -> list:
 
 
 def load(given=()):
-    """Import every plugin of the command (InputError, one line, for one that cannot be)."""
+    """Import every plugin of the command (InputError, one line, for one that cannot be, or
+    that exits or raises while it is imported: the plugin's failure, never the command's end)."""
+    from damage_dolfinx.core.parameters import InputError
     for name in names(given):
-        load_one(name.strip())
+        name = name.strip()
+        try:
+            load_one(name)
+        except InputError:
+            raise
+        except SystemExit as exc:  # a plugin may not end the command (exit 0, no run)
+            raise InputError(f"plugin {name!r} called sys.exit({exc.code!r}) while being "
+                             "imported: the plugin failed") from None
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # noqa: BLE001 - the plugin's failure, one line
+            text = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+            raise InputError(f"plugin {name!r} failed while being imported: "
+                             f"{type(exc).__name__}" + (f": {text}" if text else "")) from None
 
 
 def load_one(name):

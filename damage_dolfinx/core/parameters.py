@@ -96,14 +96,15 @@ EXTRA_RULES = {
 }
 
 
-#: parameters for which inf is meaningful ("no truncation"); every other number must be finite
-INFINITE_ALLOWED = frozenset({"L_trunc"})
+from damage_dolfinx.core.validation import INFINITE_ALLOWED  # noqa: E402,F401 (with the checks)
 
 
 def _coerce(old, value, key):
-    """Convert a command-line string to the type of the current value."""
+    """Convert a command-line string to the type of the current value; any other value is
+    checked against that type (validation.number_like: a bool is not a number)."""
     if not isinstance(value, str):
-        return value
+        from damage_dolfinx.core.validation import number_like
+        return number_like(old, value, key)
     try:
         if isinstance(old, bool):
             if value.lower() in ("1", "true", "yes", "on"):
@@ -121,6 +122,9 @@ def _coerce(old, value, key):
         allowed = (" (inf is allowed only for " + ", ".join(sorted(INFINITE_ALLOWED)) + ")"
                    if math.isinf(number) else "")
         raise InputError(f"parameter {key} must be a finite number, got {value!r}{allowed}")
+    if 0.0 < abs(number) < 2.2250738585072014e-308:
+        raise InputError(f"parameter {key} = {value} underflows (below the smallest normal "
+                         "number)")
     return number
 
 
@@ -136,6 +140,9 @@ class TimeGrid:
         if not (self.T > 0):
             raise InputError(f"final time T must be positive, got T = {self.T}")
         ratio = self.T / self.k
+        if not math.isfinite(ratio):
+            raise InputError(f"T/k = {self.T:g}/{self.k:g} overflows: no run takes that many "
+                             "steps")
         if round(ratio) < 1:  # the tolerance below would let any T < 1e-8 k through
             raise InputError(f"final time T = {self.T:g} is below the time step k = {self.k:g}: "
                              "the run would take no step")

@@ -13,7 +13,7 @@ PETSC_GLOBAL = ("log_view", "options_left", "options_view", "info", "malloc_dump
 def _check_name(name, hint=lambda: ""):
     """A PETSc option name (without its dash) of the package's solvers, or InputError; ``hint``
     gives what to add to the message (the command line: the double-dash option it resembles)."""
-    from damage_dolfinx.core.parameters import InputError
+    from damage_dolfinx.core.errors import InputError
     if not isinstance(name, str) or not name:
         raise InputError(f"a PETSc option name is a non-empty string, got {name!r}")
     if not (name.startswith(PETSC_PREFIXES) or name in PETSC_GLOBAL):
@@ -27,7 +27,7 @@ def normalised(options) -> dict:
     a name outside the package's prefixes or a value of another type."""
     import math
     import numbers
-    from damage_dolfinx.core.parameters import InputError
+    from damage_dolfinx.core.errors import InputError
     if options is None:
         return {}
     if isinstance(options, (str, bytes)) or not hasattr(options, "items"):

@@ -15,11 +15,18 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from damage_dolfinx.core.parameters import InputError
+from damage_dolfinx.core.errors import InputError
+
+#: the smallest normal double: a nonzero number below it has lost its precision (underflow)
+TINY = sys.float_info.min
+
+#: parameters for which inf is meaningful ("no truncation"); every other number must be finite
+INFINITE_ALLOWED = frozenset({"L_trunc"})
 
 #: the largest sweep grid (points); larger grids are refused before any work
 MAX_SWEEP_POINTS = 10000
@@ -47,6 +54,9 @@ def real(name, value, *, low=None, high=None, low_open=False, allow_none=False,
     v = float(value)
     if not math.isfinite(v):
         raise InputError(f"{name} must be a finite number, got {v}")
+    if 0.0 < abs(v) < TINY:
+        raise InputError(f"{name} = {v:g} underflows (below {TINY:.3g}, the smallest normal "
+                         "number): no time, size or datum is that small")
     if low is not None and (v <= low if low_open else v < low):
         raise InputError(f"{name} must be {'>' if low_open else '>='} {low:g}, got {v:g}")
     if high is not None and v > high:
@@ -201,6 +211,12 @@ ARGUMENTS = {
 }
 
 
+#: the defaults of the public entries (run, steps, converge, sweep) and of the command line's
+#: options of the same name, in one place: nothing written earlier is replaced unless asked
+DEFAULTS = {"restart": False, "overwrite": False, "progress": True, "figures": True,
+            "checkpoint_every": None}
+
+
 def arguments(**given) -> dict:
     """``given`` with each value checked (and normalised: NumPy scalars to Python) by the rule
     of its name in ARGUMENTS; InputError naming the first argument that fails."""
@@ -214,7 +230,7 @@ def check_run(out=None, comm=None, **given):
     return arguments(out=out, **given, **extra)
 
 
-def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=True, progress=True,
+def check_converge(n, k, ref_n, ref_k, T, restart=False, overwrite=False, progress=True,
                    out=None, comm=None):
     """The levels of converge(): lists of whole n and positive k, the reference's, T, and its
     flags (its folder and communicator when given)."""
@@ -269,4 +285,93 @@ def cell_types_problem(gmsh, d):
         names = [gmsh.model.mesh.getElementProperties(t)[0] for t in types]
         return (f"it mixes cell types ({', '.join(names)}); a mesh needs one cell type "
                 "(gmsh: Mesh.RecombineAll 0 for triangles, or recombine every surface)")
+    return None
+
+
+def limit(name, value, source="") -> float:
+    """A stability limit (k_max) a model or a cache gives: a positive number or math.inf (no
+    limit); NaN, a negative number, zero or a non-number is the model's error, refused (a NaN
+    limit would let every k through: k > NaN is False)."""
+    where = f" ({source})" if source else ""
+    if not is_real(value):
+        raise InputError(f"{name}{where} must be a number, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    v = float(value)
+    if math.isnan(v) or v <= 0 or (0 < v < TINY):
+        raise InputError(f"{name}{where} must be a positive number or inf (no limit), got {v}: "
+                         "the stability limit cannot be checked")
+    return v
+
+
+def number_like(old, value, key):
+    """A parameter's new value of the type of its default: a bool is not a number and a number
+    not a bool (E=True would run with E = 1); a number is finite (inf only where meaningful)
+    and does not underflow. Strings are read by parameters._coerce."""
+    if isinstance(old, bool) and is_real(value):
+        raise InputError(f"parameter {key} is a flag (True or False), got {_shown(value)}")
+    if is_real(old) and isinstance(value, (bool, np.bool_)):
+        raise InputError(f"parameter {key} is a number, got {value!r} (a bool is not a number)")
+    if is_real(old) and not isinstance(value, str) and not is_real(value) and \
+            not callable(value):
+        raise InputError(f"parameter {key} is a number, got {_shown(value)} "
+                         f"({type(value).__name__})")
+    if is_real(value):
+        v = float(value)
+        if math.isnan(v) or (math.isinf(v) and key not in INFINITE_ALLOWED):
+            raise InputError(f"parameter {key} must be a finite number, got {v}")
+        if 0.0 < abs(v) < TINY:
+            raise InputError(f"parameter {key} = {v:g} underflows (below {TINY:.3g})")
+    return value
+
+
+def claims_problem(gmsh, d):
+    """What a gmsh model of dimension ``d`` claims and does not hold (rank 0; None: nothing):
+
+    * its nodes span only ``d`` coordinates: a 2-D mesh lies in the x-y plane (one in the x-z
+      plane would be read as a degenerate 2-D mesh, its y all equal);
+    * every cell belongs to a physical group of dimension ``d`` (an untagged cell is left out
+      of the mesh DOLFINx builds, or crashes PETSc);
+    * the cells are first order (the package's spaces and outputs are of linear geometry)."""
+    _, coords, _ = gmsh.model.mesh.getNodes()
+    xyz = np.asarray(coords, dtype=float).reshape(-1, 3)
+    if len(xyz):
+        span = xyz.max(axis=0) - xyz.min(axis=0)
+        scale = max(float(span.max()), 1e-300)
+        if d == 2 and span[2] > 1e-10 * scale:
+            flat = [("x", "y", "z")[i] for i in range(3) if span[i] <= 1e-10 * scale]
+            plane = "-".join(a for a in "xyz" if a not in flat)
+            where = f" (its {flat[0]} is constant: the {plane} plane)" if flat else ""
+            return (f"it is a 2-D mesh whose nodes span z as well{where}: a 2-D problem is in "
+                    "the x-y plane (rotate the geometry there, or mesh it in 3-D)")
+        if d == 2 and span[0] <= 1e-10 * scale or d == 2 and span[1] <= 1e-10 * scale:
+            return "it is a 2-D mesh whose nodes lie on one line (no area)"
+    for t in gmsh.model.mesh.getElementTypes(d):
+        name, _, order = gmsh.model.mesh.getElementProperties(t)[:3]
+        if order != 1:
+            return (f"its cells are of order {order} ({name}); only first-order cells are "
+                    "supported (gmsh: Mesh.ElementOrder 1)")
+    tagged = {tag for _, group in gmsh.model.getPhysicalGroups(d)
+              for tag in gmsh.model.getEntitiesForPhysicalGroup(d, group)}
+    untagged, total = 0, 0
+    for _, entity in gmsh.model.getEntities(d):
+        count = sum(len(e) for e in gmsh.model.mesh.getElements(d, entity)[1])
+        total += count
+        if entity not in tagged:
+            untagged += count
+    cell_nodes = np.unique(np.concatenate([np.asarray(n, dtype=np.int64) for n in
+                                           gmsh.model.mesh.getElements(d)[2]] or [[]]))
+    loose = 0
+    for _, group in gmsh.model.getPhysicalGroups(d - 1):
+        for entity in gmsh.model.getEntitiesForPhysicalGroup(d - 1, group):
+            for nodes in gmsh.model.mesh.getElements(d - 1, entity)[2]:
+                loose += int(np.sum(~np.isin(np.asarray(nodes, dtype=np.int64), cell_nodes)))
+    if loose:
+        return (f"tagged boundary facets have {loose} node(s) of no cell: cells were left out "
+                f"(a {'surface' if d == 2 else 'volume'} in no physical group is not saved); "
+                f"tag every cell (gmsh: Physical {'Surface' if d == 2 else 'Volume'} over "
+                f"every {'surface' if d == 2 else 'volume'})")
+    if untagged:
+        part = "surface" if d == 2 else "volume"
+        return (f"{untagged} of its {total} cells belong to no physical {part}: tag every cell "
+                f"(gmsh: Physical {part.capitalize()} over every {part})")
     return None

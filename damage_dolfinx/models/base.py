@@ -154,6 +154,22 @@ class Model:
                 "not give it: implement mesh_k_max(self) (a number, or None: no limit)")
         return None
 
+    def __init_subclass__(cls, **kwargs):
+        """A model's own ``k_max`` is checked wherever it is asked for (validation.limit: a
+        NaN, a negative or a non-number limit is refused, never compared: k > NaN is False)."""
+        super().__init_subclass__(**kwargs)
+        own = cls.__dict__.get("k_max")
+        if isinstance(own, classmethod) and not getattr(own.__func__, "_checked_limit", False):
+            raw = own.__func__
+
+            def k_max(klass, params, _raw=raw):
+                from damage_dolfinx.core.validation import limit
+                return limit("k_max", _raw(klass, params), f"model {klass.__name__}")
+            k_max._checked_limit = True
+            k_max.__doc__, k_max.__name__ = raw.__doc__, "k_max"
+            k_max.__wrapped__ = raw
+            cls.k_max = classmethod(k_max)
+
     @classmethod
     def boundary_roles(cls) -> dict:
         """role -> the facet tag the model reads there: ``clamped`` 1 (Gamma_D), ``traction`` 2

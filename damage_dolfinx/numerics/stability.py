@@ -320,14 +320,26 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
         exact, decided_by = stability_bound.cached(key), "cache"
         if exact is None:
             exact, decided_by = stability_cache.load(key, comm), "disk cache"
-            if exact is not None:
-                stability_bound.store(key, exact)
+            if exact is not None:  # verified, not believed: its key and the cheap bounds
+                wrong = stability_bound.cached_problem(
+                    exact, key, out, stability_bound.k_upper(K_B, K, M, m_visc, free),
+                    m_visc, critical_time_step, SAFETY)
+                if wrong:
+                    if comm.rank == 0:
+                        import sys
+                        print(f"WARNING: the stored stability limit {key[:12]} (the stability "
+                              f"cache, {stability_cache.ENV}) is not used: {wrong}; it is "
+                              "eigensolved again", file=sys.stderr, flush=True)
+                    exact = None
+                else:
+                    stability_bound.store(key, exact)
         if exact is None:
             decided_by = "eigensolve"
             exact = _eigensolved(K_B, K, M, m_visc, method)
             exact["eigen_method"] = method_used
             stability_bound.store(key, exact)
-            stability_cache.save(key, exact, comm)
+            stability_cache.save(key, {**exact, "key": key}, comm)
+        exact = {name: value for name, value in exact.items() if name != "key"}
         return {**out, **exact, "decided_by": decided_by}
     finally:
         for A in {id(a): a for a in (K_B, K, M)}.values():

@@ -131,3 +131,56 @@ def cached(k: str):
 
 def store(k: str, value: dict):
     _CACHE[k] = dict(value)
+
+
+def k_upper(K_B, K, M, m_visc, free) -> float:
+    """A cheap upper bound of k_max, the converse of :func:`bound`: for a unit vector e_i,
+    e_i^T Q(k) e_i = 4 M_ii + 2k K_B,ii/m_visc - k^2 K_ii < 0 for k above the root
+    (c + sqrt(c^2 + 4 a m))/a (a = K_ii, c = K_B,ii/m_visc, m = M_ii), so Q(k) is not positive
+    there and k_max is below it; the smallest root over the free rows (inf: none). Also
+    returns max_i K_ii/M_ii, a lower bound of omega^2_max (a Rayleigh quotient)."""
+    comm = K.getComm().tompi4py()
+    a, m = K.getDiagonal().getArray(), M.getDiagonal().getArray()
+    b = K_B.getDiagonal().getArray() if K_B is not K else a
+    inv_m = 0.0 if math.isinf(m_visc) else 1.0 / m_visc
+    use = free & (a > 0) & (m > 0)
+    c = b[use] * inv_m
+    roots = (c + np.sqrt(c * c + 4.0 * a[use] * m[use])) / a[use]
+    local = float(roots.min()) if roots.size else math.inf
+    rayleigh = float((a[use] / m[use]).max()) if roots.size else 0.0
+    return comm.allreduce(local, op=MPI.MIN), comm.allreduce(rayleigh, op=MPI.MAX)
+
+
+def cached_problem(value: dict, key_: str, bounds: dict, upper: tuple, m_visc: float,
+                   critical, safety: float) -> str | None:
+    """Why a stored stability result cannot be believed (None: it can): it must be stored under
+    its own key, its numbers finite and positive, consistent with each other (the
+    proportional formula of its omega^2, k_suggested = SAFETY k_max) and within the cheap
+    bounds of this mesh and data: max K_ii/M_ii <= omega^2_max <= the Gershgorin bound and
+    k_max_lower_bound <= k_max <= :func:`k_upper`. An entry edited, copied under another key
+    or made by a defective solve is not used (the eigensolve runs again)."""
+    if value.get("key") != key_:
+        return "it is not stored under its own key"
+    fields = ("omega2_max", "k_max", "k_max_proportional_formula", "k_suggested")
+    for name in fields:
+        v = value.get(name)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+                or v <= 0:
+            return f"its {name} is {v!r}"
+    slack = 1e-3  # the eigensolve's tolerance (stability.EIG_TOL) and the iteration's
+    omega2, k_max = value["omega2_max"], value["k_max"]
+    k_top, rayleigh = upper
+    w = bounds.get("omega2_B_upper", math.inf) + bounds.get("omega2_contact_upper", 0.0)
+    if omega2 < rayleigh * (1 - slack) or (math.isfinite(w) and omega2 > w * (1 + slack)):
+        return (f"its omega^2_max = {omega2:.6g} lies outside [{rayleigh:.6g}, {w:.6g}], the "
+                "cheap bounds of this mesh and data")
+    prop = critical(omega2, m_visc)
+    if abs(value["k_max_proportional_formula"] - prop) > slack * prop:
+        return "its proportional formula does not follow from its omega^2_max"
+    lower = bounds.get("k_max_lower_bound", 0.0)
+    if k_max < lower * (1 - slack) or k_max > k_top * (1 + slack):
+        return (f"its k_max = {k_max:.6g} lies outside [{lower:.6g}, {k_top:.6g}], the cheap "
+                "bounds of this mesh and data")
+    if abs(value["k_suggested"] - safety * k_max) > slack * k_max:
+        return "its k_suggested is not SAFETY k_max"
+    return None

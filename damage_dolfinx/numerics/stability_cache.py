@@ -14,7 +14,9 @@ never in a run's folder. Rank 0 reads and writes, the other ranks get its answer
 written to a temporary name in the same folder and renamed into place, so concurrent writers
 (two jobs finishing the same eigensolve) and a kill leave either no file or a whole one. A file
 that cannot be read, or whose content is not what was stored, is ignored (the eigensolve runs
-and rewrites it); a folder that cannot be written only means no disk cache. Delete the folder
+and rewrites it), and so is one whose numbers do not agree with its key or with the cheap
+bounds of the mesh and data (stability_bound.cached_problem, with a warning: an edited entry
+is never believed); a folder that cannot be written only means no disk cache. Delete the folder
 to clear the cache. FORMAT changes whenever the stored numbers would change for the same key.
 """
 from __future__ import annotations
@@ -27,8 +29,10 @@ from pathlib import Path
 
 #: environment variable of the cache folder (``off`` disables the disk cache)
 ENV = "DAMAGE_DOLFINX_CACHE_DIR"
-#: version of the stored results (part of every key)
-FORMAT = 1
+#: version of the stored results (part of every key); 2: each result stores its own key, and
+#: a result read back is verified against its key and the cheap bounds of the mesh and data
+#: before it is used (stability_bound.cached_problem)
+FORMAT = 2
 #: the numbers a stored result must have
 FIELDS = ("omega2_max", "k_max", "k_max_proportional_formula", "k_suggested")
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from damage_dolfinx.core.parameters import INFINITE_ALLOWED, InputError
-from damage_dolfinx.core.validation import (_shown, flag, is_real, mesh_path_problem, positive,
+from damage_dolfinx.core.validation import (TINY, _shown, flag, is_real, mesh_path_problem, positive,
                                        real, text, whole)
 
 
@@ -133,9 +133,12 @@ def _key(name, key):
 def _param_value(key, value):
     """A parameter value: a number (NumPy scalars to Python), a flag or a word."""
     if isinstance(value, (bool, np.bool_)):
-        return bool(value)
+        return bool(value)  # checked against the parameter's type (validation.number_like)
     if is_real(value):
         v = float(value) if isinstance(value, (float, np.floating)) else int(value)
+        if 0 < abs(v) < TINY:
+            raise InputError(f"params[{key!r}] = {v:g} underflows (below {TINY:.3g}, the "
+                             "smallest normal number)")
         if isinstance(v, float) and not math.isfinite(v) and not (
                 math.isinf(v) and key in INFINITE_ALLOWED):
             allowed = (" (inf is allowed only for " + ", ".join(sorted(INFINITE_ALLOWED)) + ")"

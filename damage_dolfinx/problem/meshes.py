@@ -34,7 +34,7 @@ def _check_model(dim):
                     "it holds no mesh")
         if dim is not None and d != dim:
             return f"it holds a {d}-D mesh; this problem is {dim}-D"
-        from damage_dolfinx.core.validation import cell_types_problem
+        from damage_dolfinx.core.validation import cell_types_problem, claims_problem
         mixed = cell_types_problem(gmsh, d)
         if mixed:
             return mixed
@@ -45,7 +45,7 @@ def _check_model(dim):
         if not any(g[0] == d - 1 for g in groups):
             return (f"no physical {'curve' if d == 2 else 'surface'} tags the boundary: tag the "
                     "clamped, loaded and contact parts (README: mesh files)")
-        return None
+        return claims_problem(gmsh, d)
     return check
 
 
@@ -179,12 +179,39 @@ def retag(geometry: Geometry, boundaries, required=None, model=None) -> Geometry
             if int(tag) in mapping:
                 raise InputError(f"facet tag {int(tag)} is given two roles")
             mapping[int(tag)] = internal[role]
+    roles = {tag: role for role, tags in boundaries.items()
+             for tag in _tag_numbers(geometry, role, tags, where)}
+    inside = off_boundary(geometry, sorted(mapping))
+    if inside:
+        tag, count = next(iter(inside.items()))
+        raise InputError(f"{where}: the {roles[tag]} tag {tag} lies inside the body ({count} "
+                         f"of its {counts[tag]} facets are not on the boundary): a boundary "
+                         "part must be on the boundary (an interior curve carries no load, "
+                         "contact or support)")
     ft = geometry.facet_tags
     keep = np.isin(ft.values, list(mapping))
     values = np.array([mapping[int(v)] for v in ft.values[keep]], dtype=np.int32)
     tags = compat.meshtags(geometry.mesh, geometry.mesh.topology.dim - 1, ft.indices[keep], values)
     return Geometry(geometry.mesh, tags, geometry.h, geometry.grid, geometry.description,
                     geometry.names)
+
+
+def off_boundary(geometry: Geometry, tags) -> dict:
+    """{tag: number of its facets not on the boundary of the body} over all ranks, for the
+    ``tags`` that have such facets (collective)."""
+    import dolfinx
+    msh, ft = geometry.mesh, geometry.facet_tags
+    tdim = msh.topology.dim
+    local = np.zeros(len(tags), dtype=np.int64)
+    if ft is not None and len(tags):
+        msh.topology.create_connectivity(tdim - 1, tdim)
+        exterior = dolfinx.mesh.exterior_facet_indices(msh.topology)
+        owned = ft.indices < msh.topology.index_map(tdim - 1).size_local
+        outside = np.isin(ft.indices, exterior)
+        for i, tag in enumerate(tags):
+            local[i] = int(np.sum((ft.values == tag) & owned & ~outside))
+    total = msh.comm.allreduce(local)
+    return {int(tag): int(n) for tag, n in zip(tags, total) if n}
 
 
 def _tag_numbers(geometry, role, tags, where) -> list:

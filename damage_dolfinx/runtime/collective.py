@@ -230,6 +230,7 @@ def outcome(comm=MPI.COMM_WORLD):
         try:
             yield
         except BaseException as exc:
+            _taken(exc)
             if comm.size == 1 and _LOCAL.depth == 1:
                 for folder, kind in _FOLDERS[start:]:
                     mark(folder, exc, kind=kind)
@@ -248,6 +249,7 @@ def outcome(comm=MPI.COMM_WORLD):
     try:
         yield
     except BaseException as exc:  # noqa: BLE001 - every exception is decided collectively
+        _taken(exc)
         failure = exc
     finally:
         _LOCAL.depth = 0
@@ -261,9 +263,9 @@ def outcome(comm=MPI.COMM_WORLD):
             _abort(comm, failure, folders)
         time.sleep(0.002)
     outcomes = agree.allgather(mine)
-    agree.Free()
     failed = [o for o in outcomes if o is not None]
     if not failed:
+        agree.Free()
         _CREATED.clear()
         return
     rank, code, kind, text = failed[0]
@@ -274,10 +276,20 @@ def outcome(comm=MPI.COMM_WORLD):
         exc = failure if failure is not None else RankFailure(text, code, kind)
         for folder, where in folders:
             mark(folder, exc, alone, where)
+    agree.Barrier()  # the status is on disk before any rank's caller sees the exception
+    agree.Free()
     if failure is not None and (rank == comm.rank or classify(failure)[:2] == (code, kind)):
         raise failure  # this rank's own exception is of the decided kind: the caller's catch
     raise decided(text + (f" (rank {rank})" if len(failed) < comm.size else ""), code,
                   kind) from failure
+
+
+def _taken(exc):
+    """A stop signal's exception reached the call: it is not delivered again
+    (signals.stop_outside_runs)."""
+    if isinstance(exc, KeyboardInterrupt):
+        from damage_dolfinx.runtime.signals import taken
+        taken()
 
 
 def decided(text, code, kind) -> RankFailure:

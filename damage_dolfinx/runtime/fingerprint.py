@@ -33,12 +33,16 @@ from mpi4py import MPI
 from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.runtime import io
 
-#: the fingerprint's format: the loads' and laws' hashes (and a zeta0 function's digest) of
-#: another version are not compared
-VERSION = 3
+#: the fingerprint's format; a checkpoint of another format is refused (its items cannot all be
+#: checked: format 3 had neither the model's code nor the tagged geometry)
+VERSION = 4
 
 #: how the items of the fingerprint are named in a refusal (in the order they are compared)
-ITEMS = {"mesh": "the mesh", "mesh_nodes": "the mesh's nodes or cells",
+ITEMS = {"version": "the fingerprint's format (a checkpoint of another version of the "
+                    "package: its run cannot be fully checked)",
+         "model_code": "the model's code", "mesh": "the mesh",
+         "mesh_nodes": "the mesh's nodes or cells",
+         "tagged_geometry": "the mesh's tagged facets and cells (where each tag lies)",
          "traction": "the traction", "body_force": "the body force",
          "damage_law": "the damage law", "zeta0": "the initial damage zeta0",
          "boundaries": "the boundary parts", "irreversible": "irreversibility",
@@ -86,7 +90,9 @@ def fingerprint(ex, data) -> dict:
                    f"{msh.topology.index_map(0).size_global} vertices, box "
                    f"{np.round(lo, 9).tolist()}-{np.round(hi, 9).tolist()}, tags "
                    f"{sorted(tag_counts(data.geometry).items())}",
-           "mesh_nodes": mesh_digest(msh)}
+           "mesh_nodes": mesh_digest(msh),
+           "tagged_geometry": tagged_digest(data.geometry),
+           "model_code": model_code(ex)}
     out.update({key: user[key] for key in ("traction", "body_force", "damage_law")})
     if "zeta0_values" in user:  # its values at the nodes, in an order no partition changes
         out["zeta0"] = "function of x, nodal digest " + nodal_digest(
@@ -133,7 +139,9 @@ def first_difference(saved, now):
     not come from UFL."""
     if not isinstance(saved, dict) or not isinstance(now, dict):
         return None
-    same_version = saved.get("version", 1) == now.get("version", 1)
+    if saved.get("version", 1) != now.get("version", 1):  # not every item can be checked
+        return "version", saved.get("version", 1), now.get("version", 1)
+    same_version = True
     for key in ITEMS:
         if key in UFL_ITEMS and not same_version:
             continue
@@ -192,6 +200,73 @@ def nodal_digest(comm, coords, values=None) -> str:
         every = np.unique(np.concatenate(gathered), axis=0)  # sorted rows, ghosts once
         digest = hashlib.sha1(np.ascontiguousarray(every).tobytes()).hexdigest()[:16]
     return comm.bcast(digest, root=0)
+
+
+def tagged_digest(geometry) -> str:
+    """Where each tag lies: the midpoints of the tagged facets with their tag, and of the tagged
+    cells with theirs, by nodal_digest (partition-independent): two boundary tags swapped,
+    with the same counts, are another mesh."""
+    from damage_dolfinx import compat
+    msh = geometry.mesh
+    gdim, tdim = msh.geometry.dim, msh.topology.dim
+    parts = []
+    for tags, dim in ((geometry.facet_tags, tdim - 1), (getattr(geometry, "cell_tags", None),
+                                                        tdim)):
+        if tags is None:
+            parts.append("none")
+            continue
+        indices = np.asarray(tags.indices, dtype=np.int32)
+        if dim == tdim:
+            mids = compat.cell_midpoints(msh)[indices, :gdim] if len(indices) else \
+                np.zeros((0, gdim))
+        else:
+            msh.topology.create_connectivity(dim, 0)
+            import dolfinx
+            mids = dolfinx.mesh.compute_midpoints(msh, dim, indices)[:, :gdim] \
+                if len(indices) else np.zeros((0, gdim))
+        parts.append(nodal_digest(msh.comm, mids, np.asarray(tags.values, dtype=float)))
+    return " ".join(parts)
+
+
+def model_code(ex) -> str:
+    """A digest of the model's own code: the source of its class and of every class of its MRO
+    outside this package (the package's models are its version), else their functions'
+    bytecode and constants (a class made by exec). An edit of the model changes it."""
+    import inspect
+    from damage_dolfinx.models.registry import model
+    try:
+        cls = model(ex.model)
+    except Exception:  # noqa: BLE001 - no model class: nothing of the user's to hash
+        return "none"
+    h = hashlib.sha1()
+    for klass in cls.__mro__:
+        module = getattr(klass, "__module__", "") or ""
+        if module.startswith("damage_dolfinx") or module == "builtins":
+            continue
+        try:
+            h.update(inspect.getsource(klass).encode())
+        except (OSError, TypeError):
+            for name in sorted(vars(klass)):
+                h.update(name.encode() + _code_bytes(vars(klass)[name]))
+    return h.hexdigest()[:16]
+
+
+def _code_bytes(obj) -> bytes:
+    """The bytecode and constants of a function (a classmethod's, a property's), recursively;
+    a plain value by its repr."""
+    for attr in ("__func__", "fget"):
+        if getattr(obj, attr, None) is not None:
+            obj = getattr(obj, attr)
+    code = getattr(obj, "__code__", None)
+    if code is None:
+        return repr(obj).encode() if isinstance(obj, (int, float, str, tuple, bool)) else b""
+
+    def walk(c):
+        out = c.co_code + repr(c.co_names).encode()
+        for const in c.co_consts:
+            out += walk(const) if hasattr(const, "co_code") else repr(const).encode()
+        return out
+    return walk(code)
 
 
 def mesh_digest(msh) -> str:

@@ -60,11 +60,14 @@ class Run(RunRecords):
     #: under MPI: runtime/steps.together)
     handshake = False
 
-    def abandon(self, steps):
+    def abandon(self, steps, tell=False):
         """End the generator ``steps`` after the caller's own code raised inside the loop: no
         outputs of a stop (a rank alone in this may not enter a collective write while the
-        others solve; the exception decides the status, runtime/collective.py)."""
-        self.abandoned = True
+        others solve; the exception decides the status, runtime/collective.py). ``tell``: the
+        other ranks learn it at their next hand-over (dd.steps at the script's end: they raise
+        LoopLeft); otherwise no collective call at all (the call's outcome decides, or ends
+        the job)."""
+        self.abandoned = "told" if tell else "alone"
         steps.close()
 
     def steps(self):
@@ -230,13 +233,14 @@ class Run(RunRecords):
             try:
                 yield Step(self)
             except GeneratorExit:
-                if self.abandoned or not together(self, leaving=True):
+                if self.abandoned == "alone" or not together(
+                        self, 2 if self.abandoned else 1) or self.abandoned:
                     raise
                 stop = "stopped"
                 if stepper.n < N and self.supported:
                     self.save_checkpoint()
             else:
-                together(self, leaving=False)
+                together(self, 0)
             while stop is None and stepper.n < N:
                 stop, step = self._step()
                 if stop:
@@ -244,12 +248,13 @@ class Run(RunRecords):
                 try:  # here, not in _step: a close reaches a nested generator's caller too
                     yield Step(self)
                 except GeneratorExit:  # the caller stopped here: the outputs of a stop
-                    if self.abandoned or not together(self, leaving=True):
+                    if self.abandoned == "alone" or not together(
+                        self, 2 if self.abandoned else 1) or self.abandoned:
                         raise
                     self._outputs("stopped", *step)
                     stop = "stopped"
                 else:
-                    together(self, leaving=False)
+                    together(self, 0)
             self._finish(stop)
         except (ConvergenceError, io.OutputError) as exc:
             self._failed(exc)

@@ -47,9 +47,14 @@ def _mesh_problem(path, dim, required):
         got = gmsh.model.getDimension()
         if got != dim or len(gmsh.model.mesh.getElementTypes(dim)) == 0:
             return f"holds a {got}-D mesh, this example needs a {dim}-D one"
+        from damage_dolfinx.core.validation import claims_problem
         mixed = cell_types_problem(gmsh, dim)
         if mixed:
             return mixed
+        if gmsh.model.getPhysicalGroups(dim):
+            mixed = claims_problem(gmsh, dim)
+            if mixed:
+                return mixed
         if not gmsh.model.getPhysicalGroups(dim):
             return f"has no physical group of dimension {dim} (the cells)"
         tags = {t for _, t in gmsh.model.getPhysicalGroups(dim - 1)}

@@ -18,6 +18,13 @@ from damage_dolfinx.runtime.guards import state_problem
 from damage_dolfinx.runtime.runfolder import add_to_manifest
 from damage_dolfinx.runtime.signals import RunInterrupted
 
+def _is_number(value) -> bool:
+    import numbers
+    import numpy as np
+    return isinstance(value, (numbers.Real, np.floating, np.integer)) and \
+        not isinstance(value, (bool, np.bool_))
+
+
 class ColumnError(RuntimeError):
     """A model reported a scalar that no history column takes, or left a declared one out."""
 
@@ -95,6 +102,12 @@ class RunRecords:
     def check_columns(self, values):
         """Every value has its column, and every column the model declares has its value
         after each step (the initial state has no step statistics)."""
+        wrong = [f"{key} = {value!r}" for key, value in values.items()
+                 if key != "step_time_s" and value is not None and not _is_number(value)]
+        if wrong:
+            raise ColumnError(f"model {type(self.stepper).__name__}: history values must be "
+                              f"numbers, got {', '.join(wrong[:3])} (a scheme's solve returns "
+                              "its iteration count, a scalar its value)")
         extra = sorted(set(values) - self.columns)
         missing = sorted(set(self.model_columns) - set(values)) if values["step"] > 0 else []
         if extra or missing:

@@ -42,8 +42,9 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
         history_every=None, comm=MPI.COMM_WORLD, on_step=None) -> dict:
     """Run one case (a run description, a Problem or a registered name) and write its outputs
     to ``out``; returns the summary. ``on_step(step)`` (a :class:`Step`) is called after the
-    initial state and after every step; a true return value stops the run there (collectively:
-    every rank must decide alike).
+    initial state and after every step; a true return value (on any rank) stops every rank
+    there, an exception (on any rank) ends every rank with the status "failed": the ranks
+    decide together after each call (runtime/callbacks.py).
     With ``time_limit`` (seconds) the run stops after the step that exceeds it, with status
     "time_limit" (used by benchmarks that skip cells a solver cannot finish).
 
@@ -69,14 +70,15 @@ def run(example_id, out, n=None, k=None, T=None, h=None, overrides=None, mesh_fi
     into (runfolder.claim_folder: the manifest). A NaN, an infinity or a zeta outside
     [zeta_star, 1] (beyond STATE_TOLERANCE) in a field, and every exception of a solver, end
     the run as a ConvergenceError with status "failed" in summary.json."""
+    from damage_dolfinx.runtime.callbacks import decide
     from damage_dolfinx.runtime.loop import Run  # imported when a run starts (dolfinx)
     r = Run.prepare(example_id, out, n, k, T, h, overrides, mesh_file, write_every, progress,
                     figures, time_limit, checkpoint_every, checkpoint_seconds, restart,
                     overwrite, history_every, comm)
     steps = r.steps()
     try:
-        for step in steps:
-            if on_step is not None and on_step(step):
+        for step in steps:  # on_step: decided on every rank alike (runtime/callbacks.py)
+            if on_step is not None and decide(r.comm, on_step, step, step=step.n):
                 steps.close()
     except BaseException:  # on_step raised (the run's own failures have ended the loop)
         r.abandon(steps)

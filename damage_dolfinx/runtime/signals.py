@@ -31,10 +31,48 @@ class SignalStop(KeyboardInterrupt):
 
 
 def stop_outside_runs(signum, frame):
-    """Handler of the command line for SIGTERM and SIGINT outside a run's loop (set-up, a
-    convergence study, a sweep between points): raise SignalStop."""
+    """Handler of the command line for SIGTERM, SIGINT and SIGUSR1 outside a run's loop
+    (set-up, a convergence study, a sweep between points): raise SignalStop.
+
+    Not inside an import (a module half imported would break the command's way out with a
+    traceback): there the stop is delivered again shortly after (:func:`_again`), as it is
+    until the command has taken it (:func:`taken`), since Python drops an exception raised in
+    a finaliser or a weakref callback ("Exception ignored in ...")."""
     RECEIVED["signum"] = RECEIVED["signum"] or signum
+    _PENDING["taken"] = False
+    _again(signum)
+    if _in_import(frame):
+        return
     raise SignalStop(signum)
+
+
+#: a stop of the command line's handler not yet taken by the command (see stop_outside_runs)
+_PENDING = {"taken": True}
+#: seconds between two deliveries of a stop not yet taken
+AGAIN_AFTER = 0.1
+
+
+def taken():
+    """The command has taken its stop (it prints the line and ends): no delivery again."""
+    _PENDING["taken"] = True
+
+
+def _in_import(frame) -> bool:
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _again(signum):
+    def deliver():
+        import _thread
+        if not _PENDING["taken"] and signal.getsignal(signum) is stop_outside_runs:
+            _thread.interrupt_main(signum)
+    timer = threading.Timer(AGAIN_AFTER, deliver)
+    timer.daemon = True
+    timer.start()
 
 
 @contextlib.contextmanager
@@ -66,6 +104,9 @@ class StopSignals:
         if threading.current_thread() is threading.main_thread():
             self._previous = {s: signal.signal(s, self._handle) for s in STOP_SIGNALS}
         _ACTIVE.append(self)
+        if not _PENDING["taken"] and RECEIVED["signum"]:  # a stop not yet taken (it came
+            _PENDING["taken"] = True                        # inside an import): now
+            self.request(RECEIVED["signum"])
         return self
 
     def request(self, signum):

@@ -28,27 +28,40 @@ class LoopLeft(RuntimeError):
     """dd.steps under MPI: the loop ended on some ranks (an exception of the loop body, or a
     break the others did not take) while this rank went on."""
 
+    exit_status = 3
 
-def together(run, leaving: bool) -> bool:
+
+#: what a rank says after each hand-over: its caller goes on, left the loop (a stop), or
+#: raised inside the loop (the script ended on an uncaught exception: the run is abandoned)
+GOING_ON, LEAVING, ABANDONING = 0, 1, 2
+
+
+def together(run, leaving: int) -> bool:
     """After each hand-over of a step (``run.handshake``: dd.steps on several ranks), every
-    rank says whether its caller left the loop there (one allgather of a flag; nothing on one
-    rank or for dd.run). Returns True when the outputs of a stop may be written (every rank
-    leaves, or no handshake). When only some ranks leave: those return False (they write
-    nothing collective and end their run), the others mark summary.json "failed" and raise
-    :class:`LoopLeft`, so that no rank waits for another that will never come."""
+    rank says whether its caller goes on, left the loop there or raised (one allgather of a
+    small int; nothing on one rank or for dd.run, whose callback is decided by
+    runtime/callbacks.decide). Returns True when the outputs of a stop may be written (every
+    rank leaves, none raised, or no handshake). Otherwise the leaving ranks return False (they
+    write nothing collective and end their run) and the ranks that went on mark summary.json
+    "failed" and raise :class:`LoopLeft`, so that no rank waits for another that will never
+    come."""
     comm = run.comm
     if not run.handshake or comm.size == 1:
         return True
-    left = [rank for rank, flag in enumerate(comm.allgather(bool(leaving))) if flag]
-    if not left or len(left) == comm.size:
+    said = comm.allgather(int(leaving))
+    left = [rank for rank, flag in enumerate(said) if flag]
+    raised = [rank for rank, flag in enumerate(said) if flag == ABANDONING]
+    if not left or (len(left) == comm.size and not raised):
         return True
     if leaving:
         return False
     n = run.stepper.n
+    why = (f"the loop body raised on rank(s) {', '.join(map(str, raised))}" if raised else
+           "an exception of its loop body, or a break the others did not take; 'with "
+           "dd.steps(...) as run:' records the exception itself")
     error = LoopLeft(f"the loop over the steps ended on rank(s) {', '.join(map(str, left))} at "
-                     f"step {n} while the others went on (an exception of its loop body, or a "
-                     "break the others did not take; 'with dd.steps(...) as run:' records the "
-                     "exception itself); the run is stopped without the outputs of a stop")
+                     f"step {n} while the others went on ({why}); the run is stopped without "
+                     "the outputs of a stop")
     if comm.rank == min(set(range(comm.size)) - set(left)):
         from damage_dolfinx.runtime.collective import mark
         mark(run.out, error)
@@ -64,6 +77,8 @@ class Steps:
         run.handshake = True
         self._steps = run.steps() if within is None else within(run.steps())
         self._outcome = None
+        from damage_dolfinx.runtime.callbacks import opened
+        opened(self)  # closed at the script's end if the caller left it open
 
     # -- the iterator
     def __iter__(self):
@@ -75,6 +90,22 @@ class Steps:
     def close(self):
         """Stop the run at the current step (status "stopped", outputs and a checkpoint);
         collective: every rank stops at the same step."""
+        self._steps.close()
+
+    def _end_at_exit(self, uncaught):
+        """The script ended with this iterator open (runtime/callbacks.close_at_exit): after an
+        uncaught exception the run is abandoned ("failed" with that error), else it stops at
+        its current step ("stopped", with its outputs and a checkpoint)."""
+        if self._steps.gi_frame is None:  # finished or closed already
+            return
+        if uncaught is not None:
+            try:
+                self._run.abandon(self._steps, tell=True)
+            finally:
+                from damage_dolfinx.runtime.collective import mark
+                if self._comm.rank == 0:
+                    mark(self._run.out, uncaught)
+            return
         self._steps.close()
 
     @property

@@ -33,6 +33,7 @@ from damage_dolfinx.studies.convergence_tables import (fitted_rates, plot_conver
 from damage_dolfinx.numerics.solvers import ConvergenceError
 from damage_dolfinx.studies.convergence_cells import (  # noqa: F401 (SERIAL_CELL_MAX_N)
     SERIAL_CELL_MAX_N, _CoarseRun, _Transfers, _cell_geometry, _check_states, _component_norms,
+    check_family,
     _error_definition, _norm_statement, _owners)
 
 from damage_dolfinx.studies.convergence_resume import (SCHEMA, check_restart, level_fingerprints,
@@ -193,6 +194,7 @@ def _lockstep(ex, out, ref_n, ref_k, ns, ks, T, overrides, progress, comm, seria
             elif owner == comm.rank:
                 stepper = ex.build(MPI.COMM_SELF, n=n, k=k, T=T, overrides=overrides)
             runs.append(_CoarseRun(n, k, int(round(k / ref_k)), owner, stepper))
+    check_family(ref, ref_n, runs, comm)  # the levels cover one domain and refine
     geometry = _cell_geometry(runs, comm)
     transfers = _Transfers(ref, ref_n, ns, geometry, comm)
     outbox = []

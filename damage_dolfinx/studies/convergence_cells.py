@@ -150,6 +150,61 @@ def _cell_geometry(runs, comm):
     return out
 
 
+def _box(msh):
+    """(lo, hi) of the mesh's nodes over its ranks (collective on its communicator)."""
+    x = msh.geometry.x
+    lo = np.array(x.min(axis=0) if len(x) else np.full(3, np.inf), dtype=float)
+    hi = np.array(x.max(axis=0) if len(x) else np.full(3, -np.inf), dtype=float)
+    if msh.comm.size > 1:
+        msh.comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+        msh.comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
+    return lo, hi
+
+
+def check_family(ref, ref_n, runs, comm):
+    """A family's levels are what a convergence study needs (before any step): every level's
+    mesh spans the reference's domain (its bounding box, within half a cell) and the meshes
+    refine as n grows (h strictly smaller at a larger n, the reference finest). A family that
+    ignores n, or builds another domain at some n, is refused: its errors and rates would mean
+    nothing. Collective on ``comm``."""
+    mine = {}
+    for r in runs:  # the distributed cells collectively (same order on every rank)
+        if r.stepper is not None and r.owner is None:
+            box = _box(r.stepper.mesh)
+            if comm.rank == 0:
+                mine[r.n] = (r.stepper.data.geometry.h, *box)
+        elif r.stepper is not None and r.owner == comm.rank:
+            mine[r.n] = (r.stepper.data.geometry.h, *_box(r.stepper.mesh))
+    ref_box = None
+    if ref is not None and ref.mesh.comm.size > 1:
+        ref_box = (ref.data.geometry.h, *_box(ref.mesh))
+    elif ref is not None:
+        ref_box = (ref.data.geometry.h, *_box(ref.mesh))
+    levels = {}
+    for part in comm.allgather(mine):
+        levels.update(part)
+    ref_box = comm.bcast(ref_box if comm.rank == 0 else None, root=0)
+    if ref_box is None:
+        return
+    levels[ref_n] = ref_box
+    ns = sorted(levels)
+    for a, b in zip(ns, ns[1:]):
+        if not levels[b][0] < levels[a][0] * (1 - 1e-9):
+            raise InputError(f"the meshes of this family cannot be compared: they do not "
+                             f"refine as n grows, h = "
+                             f"{levels[a][0]:.6g} at n = {a} and h = {levels[b][0]:.6g} at "
+                             f"n = {b} (a family (comm, n) -> mesh must be finer at a larger n)")
+    h_ref, lo_ref, hi_ref = ref_box
+    for n in ns:
+        h, lo, hi = levels[n]
+        if max(np.abs(lo - lo_ref).max(), np.abs(hi - hi_ref).max()) > 0.5 * h + 1e-12:
+            raise InputError(f"the meshes of this family cannot be compared: they do not cover "
+                             f"one domain, n = {n} spans "
+                             f"{np.round(lo, 6).tolist()}-{np.round(hi, 6).tolist()}, the "
+                             f"reference n = {ref_n} {np.round(lo_ref, 6).tolist()}-"
+                             f"{np.round(hi_ref, 6).tolist()}")
+
+
 class _Transfers:
     """The coarse-to-fine transfers of a study: exact nested transfer (post.nested_transfer)
     when every mesh of the family is a nested structured grid of the reference's, point
