@@ -37,11 +37,24 @@ LAYERS = (
 )
 
 
+#: the loose modules of earlier layouts -> the folder that holds them now: run with an older
+#: checkout's interpreter, this file draws that checkout's picture on today's floors
+OLD_NAMES = {"errors": "core", "parameters": "core", "departures": "core", "validation": "core",
+             "validation_problem": "problem", "validation_scalars": "problem",
+             "blocks": "models", "laws": "models", "problem": "problem",
+             "description": "problem", "meshes": "problem", "workflow": "api",
+             "results": "api", "model_check": "api"}
+
+
 def floor_of(folder: str) -> int:
+    folder = OLD_NAMES.get(folder, folder) if folder not in FOLDERS else folder
     for i, names in enumerate(LAYERS):
         if folder in names:
             return i
     raise KeyError(folder)
+
+
+FOLDERS = {n for names in LAYERS for n in names}
 
 
 def package_files() -> dict:
@@ -99,7 +112,11 @@ def edges(modules=None, extra=()) -> list:
 
 
 def folder(module: str) -> str:
+    """The module's folder (its room on a floor); a loose module of an earlier layout is its own
+    room, on the floor of the folder that holds it now (OLD_NAMES)."""
     parts = module.split(".")
+    if len(parts) == 2 and parts[1] in OLD_NAMES:
+        return parts[1]
     return parts[1] if len(parts) > 1 else ""
 
 
@@ -125,6 +142,7 @@ def circles(all_edges) -> list:
     for a, b, _ in all_edges:
         if not b.startswith(a + ".") and not a.startswith(b + "."):  # a package and its own parts
             graph[a].add(b)
+            graph[b]  # every module a node
     index, low, stack, on, out = {}, {}, [], set(), []
     counter = [0]
 
@@ -165,14 +183,22 @@ def main() -> int:
         rooms[folder(name)].append(name)
     print(f"{len(modules)} modules, {len(all_edges)} imports, {len(LAYERS)} floors")
     for i, names in reversed(list(enumerate(LAYERS))):
-        cells = ", ".join(f"{n or '(face)'} {len(rooms.get(n, []))}" for n in names)
+        here = [n for n in rooms if floor_of(n) == i]
+        cells = ", ".join(f"{n or '(face)'} {len(rooms[n])}" for n in sorted(here, key=str))
         print(f"  floor {i:2d}: {cells}")
-    loose = [m for m in modules if m.count(".") == 1 and folder(m) not in
-             {n for names in LAYERS for n in names}]
+    loose = [m for m, path in modules.items() if m.count(".") == 1 and path.name != "__init__.py"
+             and m.split(".")[1] not in ("forms", "geometries")]
     print(f"loose modules at the package root: {len(loose)} {loose if loose else ''}")
     bad = upward(all_edges)
-    print(f"imports that run up or across: {len(bad)}")
+    pairs = {}
     for a, b, line, why in bad:
+        pairs.setdefault((a, b), (line, why))
+    by_reason = {}
+    for line, why in pairs.values():
+        by_reason[why] = by_reason.get(why, 0) + 1
+    print(f"imports that run up or across: {len(pairs)} module pairs "
+          f"({', '.join(f'{n} {why}' for why, n in sorted(by_reason.items())) or 'none'})")
+    for (a, b), (line, why) in sorted(pairs.items()):
         print(f"  {a}:{line} -> {b} ({why})")
     groups = circles(all_edges)
     print(f"circles: {len(groups)}")

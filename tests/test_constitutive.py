@@ -5,7 +5,8 @@ import ufl
 from dolfinx import fem
 
 from damage_dolfinx import compat
-from damage_dolfinx.forms import constitutive as C, damage
+from damage_dolfinx.forms import constitutive as C
+from damage_dolfinx.numerics import damage
 from damage_dolfinx.core.parameters import ModelParameters
 
 RNG = np.random.default_rng(2007)

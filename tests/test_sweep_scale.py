@@ -159,7 +159,7 @@ def test_a_point_job_on_two_ranks_joins_a_partial_sweep(tmp_path, serial):
 
 @pytest.mark.parametrize("extra, expected", [
     (["--ranks-per-point", "2"], "2 ranks per point do not divide the 1 rank(s)"),
-    (["--ranks-per-point", "0"], "ranks_per_point must be a whole number >= 1"),
+    (["--ranks-per-point", "0"], "--ranks-per-point must be a whole number >= 1"),
     (["--point", "4"], "point 4 is not in the grid: its 4 points are 0 to 3"),
     (["--point", "-1"], "point must be a whole number >= 0"),
     (["--point", "1", "--max-points", "1"], "exclude each other"),

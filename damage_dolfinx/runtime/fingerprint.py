@@ -191,13 +191,18 @@ def nodal_digest(comm, coords, values=None) -> str:
     """A hash of points (and values at them) that no partition changes: every rank's rows
     (ghost copies included) gathered on rank 0, rounded to 12 digits, duplicates removed,
     sorted by coordinates. Collective; the same text on every rank."""
-    rows = np.asarray(coords, dtype=float).reshape(len(coords), -1)
-    if values is not None:
-        rows = np.column_stack([rows, np.asarray(values, dtype=float).reshape(len(rows), -1)])
+    def table(a, n):  # n rows (a rank may hold none: NumPy cannot reshape 0 values to (0, -1))
+        a = np.asarray(a, dtype=float)
+        return a.reshape(n, -1) if a.size else np.zeros((n, 0))
+    n = len(coords)
+    rows = table(coords, n)
+    if values is not None and n:
+        rows = np.column_stack([rows, table(values, n)])
     gathered = comm.gather(np.round(rows, 12) + 0.0, root=0)  # + 0.0: no negative zero
     digest = None
     if comm.rank == 0:
-        every = np.unique(np.concatenate(gathered), axis=0)  # sorted rows, ghosts once
+        held = [g for g in gathered if g.shape[0]]  # the ranks that hold rows
+        every = np.unique(np.concatenate(held), axis=0) if held else np.zeros((0, 0))
         digest = hashlib.sha1(np.ascontiguousarray(every).tobytes()).hexdigest()[:16]
     return comm.bcast(digest, root=0)
 

@@ -6,7 +6,7 @@ floors: tests/layers.py) are counted. A call of a module's own functions stays i
 call of an object handed down (a Problem's property, a user's load, a model's sub-step called by
 the loop) goes where the object was made, not through an import, and is no climb.
 
-    python benchmarks/structure/walk.py            # both entries, on 2.2-ex1 (n = 4, two steps)
+    python tests/walk.py            # both entries, on 2.2-ex1 (n = 4, two steps)
 
 The floors of modules that moved into the layers are looked up under their new names
 (``OLD_NAMES``), so that the same command measures an older checkout too.
@@ -18,15 +18,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 import layers  # noqa: E402
-
-#: modules of earlier layouts -> the folder they live in now
-OLD_NAMES = {"errors": "core", "parameters": "core", "departures": "core", "validation": "core",
-             "validation_problem": "problem", "validation_scalars": "problem",
-             "blocks": "models", "laws": "models", "problem": "problem",
-             "description": "problem", "meshes": "problem", "workflow": "api",
-             "results": "api"}
+from layers import OLD_NAMES  # noqa: E402  (modules of earlier layouts -> their folder now)
 
 
 class Stop(Exception):
