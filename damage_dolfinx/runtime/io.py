@@ -133,7 +133,7 @@ class XDMFSeries:
 
     def __init__(self, path, msh, index=None, since=None):
         """A new series at ``path`` (its data in ``path`` with .h5); with ``index`` (a
-        restart's segment) the run's index file, whose time grids t < ``since`` are kept before
+        restart's segment) the run's index file, whose time grids t <= ``since`` are kept before
         this segment's (series.py). Collective."""
         from damage_dolfinx.runtime.series_file import SeriesWriter
         self.path, self.comm = Path(path), msh.comm

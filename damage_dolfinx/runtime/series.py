@@ -3,10 +3,11 @@
 A run writes ``fields.xdmf`` + ``fields.h5`` (series_file.py: one grid per output time holding
 every field, the mesh in a rank-independent node order). A restart from step N writes its own
 segment ``fields_from_stepN.h5``, and after every output time rank 0 rewrites ``fields.xdmf``
-(atomically) as the index of the whole run: the time grids t < t_N of the previous index, then
-every time of the new segment. Every segment holds the same mesh, node for node, whatever the
-number of ranks, so one mesh serves the whole series; each grid still names its own segment's
-mesh datasets, ``<segment>.h5:/path`` relative to the folder (the folder can be moved). After any
+(atomically) as the index of the whole run: the time grids t <= t_N of the previous index, then
+every later time of the new segment (t_N itself too when the previous index lacks it). Every
+segment holds the same mesh, node for node, whatever the number of ranks, so one mesh serves
+the whole series; each grid still names its own segment's mesh datasets, ``<segment>.h5:/path``
+relative to the folder (the folder can be moved). After any
 number of restarts on any number of ranks, ``fields.xdmf`` is one series from t = 0 to the last
 output time, each time once; plain XDMF 3, read by ParaView, meshio and ``Series`` here (h5py).
 Folders written by earlier versions (one temporal collection per field, DOLFINx's writer) are
@@ -28,7 +29,7 @@ MECHANISM = ("fields.xdmf is the index of the whole run, one grid per output tim
              "field, nodes in the mesh's input order (the same on any number of ranks): a "
              "restart from step N writes its own fields_from_stepN.h5 and fields.xdmf is "
              "rewritten to reference the datasets of every segment (relative paths), with the "
-             "times from t_N on taken from the newest segment only")
+             "times after t_N taken from the newest segment only")
 
 
 def _is_xinclude(tag) -> bool:
@@ -90,15 +91,16 @@ def time_grids(path, root=None) -> list:
     return sorted(merged.values(), key=lambda item: item[0])
 
 
-def earlier_grids(index, before: float) -> list:
-    """The time grids of the index file ``index`` with t < ``before`` (none if it is absent or
-    does not parse)."""
+def earlier_grids(index, since: float) -> list:
+    """The time grids of the index file ``index`` with t <= ``since`` (the restart's time: its
+    grid, when the earlier run wrote it, is kept; none if the file is absent or does not
+    parse)."""
     try:
         grids = time_grids(index)
     except InputError:
         return []
-    tol = 1e-12 * max(1.0, abs(before))
-    return [(t, g) for t, g in grids if t < before - tol]
+    tol = 1e-12 * max(1.0, abs(since))
+    return [(t, g) for t, g in grids if t <= since + tol]
 
 
 def data_files(grids) -> list:

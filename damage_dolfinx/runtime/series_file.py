@@ -71,11 +71,12 @@ class MeshOrder:
         inputs = compat.geometry_input_indices(msh)
         self.node_counts = np.array(comm.allgather(self.n_nodes), dtype=np.int64)
         self.cell_counts = np.array(comm.allgather(self.n_cells), dtype=np.int64)
-        owned_inputs = self._gather(inputs[:self.n_nodes], self.node_counts, np.int64)[:, 0]
+        owned_inputs = self._gather(inputs[:self.n_nodes], self.node_counts, np.int64)
         x = self._gather(msh.geometry.x[:self.n_nodes, :self.gdim], self.node_counts)
         cells = self._gather(inputs[x_dofmap[:self.n_cells]], self.cell_counts, np.int64)
         self.node_pos = self.cell_pos = self.geometry = self.topology = None
         if comm.rank == 0:
+            owned_inputs = owned_inputs[:, 0]
             unique = np.unique(owned_inputs)
             if unique.size != owned_inputs.size:  # never: every node is owned once
                 raise RuntimeError("fields output: mesh nodes with the same input index")
@@ -215,6 +216,11 @@ class SeriesWriter:
         gathered = [(fn.name, *self.order.gathered(fn)) for fn in functions]
         if self.comm.rank != 0:
             return
+        tol = 1e-12 * max(1.0, abs(float(t)))
+        if any(abs(s - float(t)) <= tol for s, _ in self.earlier):
+            return  # the restart's own time: the earlier run's grid stays (it was written
+            # from the solve itself; a restored state lacks what only a solve gives, such as
+            # contact reactions)
         attributes = []
         with h5_open(self.h5path, "a") as f:
             for name, center, kind, values in gathered:
@@ -223,7 +229,6 @@ class SeriesWriter:
                 attributes.append((name, center, kind, path, values.shape))
         self.count += 1
         grid = grid_element(self.order, self.h5path.name, t, attributes)
-        tol = 1e-12 * max(1.0, abs(float(t)))
         self.grids = [(s, g) for s, g in self.grids if abs(s - float(t)) > tol]
         self.grids.append((float(t), grid))
         atomic_write(self.index, index_xml(self.earlier + self.grids))
