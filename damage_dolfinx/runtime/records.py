@@ -17,6 +17,10 @@ from damage_dolfinx.runtime.guards import state_problem
 from damage_dolfinx.runtime.runfolder import add_to_manifest
 from damage_dolfinx.runtime.signals import RunInterrupted
 
+#: the figure of history.csv that every run draws with its other figures
+HISTORY_FIGURE = "history.png"
+
+
 class ColumnError(RuntimeError):
     """A model reported a scalar that no history column takes, or left a declared one out."""
 
@@ -122,6 +126,18 @@ class RunRecords:
             self.summary["outputs"]["figures"].append(
                 draw_figure(self.ex, fig, self.stepper, self.out, suffix))
         io.collective(self.comm, self.out, self.at(fig.filename), draw)
+
+    def history_figure(self):
+        """history.png: every history.csv column over time (rank 0 draws; collective)."""
+        def draw():
+            add_to_manifest(self.out, [HISTORY_FIGURE], self.comm)
+            if self.comm.rank == 0:
+                from damage_dolfinx.viz.history_figure import plot_run_history
+                plot_run_history(self.out / "history.csv", self.out / HISTORY_FIGURE,
+                                 title=f"{self.ex.id}: history of the run ({self.comm.size} "
+                                       f"rank{'s' if self.comm.size > 1 else ''})")
+            self.summary["outputs"]["figures"].append({"file": HISTORY_FIGURE})
+        io.collective(self.comm, self.out, self.at(HISTORY_FIGURE), draw)
 
     def timed_figures(self):
         """Figures requested at the current time (Figure.times)."""
