@@ -185,15 +185,22 @@ def grid_element(order, h5name, t, attributes):
     return grid
 
 
-def index_xml(grids) -> bytes:
-    """The whole series: [(t, Grid element)] in time order."""
-    root = ET.Element("Xdmf", {"Version": "3.0"})
-    domain = ET.SubElement(root, "Domain", {"Name": LAYOUT})
-    collection = ET.SubElement(domain, "Grid", {"Name": "fields", "GridType": "Collection",
-                                                "CollectionType": "Temporal"})
-    collection.extend(copy.copy(g) for _, g in grids)
-    ET.indent(root, space="  ")
-    return b'<?xml version="1.0"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
+def grid_xml(grid) -> bytes:
+    """One time grid as indented XML text (serialised once: the index is rewritten from these
+    pieces after every output time, so a write costs the same at the first and the last time)."""
+    grid = copy.deepcopy(grid)
+    grid.tail = None
+    ET.indent(grid, space="  ", level=3)
+    return b"      " + ET.tostring(grid, encoding="utf-8").replace(b"<?xml version='1.0' encoding='utf-8'?>\n", b"").rstrip() + b"\n"
+
+
+def index_xml(pieces) -> bytes:
+    """The whole series from the time grids' XML ``pieces`` (grid_xml) in time order."""
+    name = LAYOUT.replace("&", "&amp;").replace('"', "&quot;").replace("<", "&lt;")
+    return (b'<?xml version="1.0"?>\n<Xdmf Version="3.0">\n  <Domain Name="'
+            + name.encode() + b'">\n    <Grid Name="fields" GridType="Collection" '
+            b'CollectionType="Temporal">\n' + b"".join(pieces)
+            + b"    </Grid>\n  </Domain>\n</Xdmf>\n")
 
 
 class SeriesWriter:
@@ -205,6 +212,7 @@ class SeriesWriter:
         self.comm, self.h5path, self.index = msh.comm, Path(h5path), Path(index)
         self.order = MeshOrder(msh)
         self.earlier, self.grids, self.count = list(earlier), [], 0
+        self._earlier_xml = [grid_xml(g) for _, g in self.earlier] if self.comm.rank == 0 else []
         if self.comm.rank == 0:
             with h5_open(self.h5path, "w") as f:
                 f.create_dataset("/Mesh/geometry", data=self.order.geometry)
@@ -229,6 +237,6 @@ class SeriesWriter:
                 attributes.append((name, center, kind, path, values.shape))
         self.count += 1
         grid = grid_element(self.order, self.h5path.name, t, attributes)
-        self.grids = [(s, g) for s, g in self.grids if abs(s - float(t)) > tol]
-        self.grids.append((float(t), grid))
-        atomic_write(self.index, index_xml(self.earlier + self.grids))
+        self.grids = [(s, g, x) for s, g, x in self.grids if abs(s - float(t)) > tol]
+        self.grids.append((float(t), grid, grid_xml(grid)))
+        atomic_write(self.index, index_xml(self._earlier_xml + [x for _, _, x in self.grids]))
