@@ -142,7 +142,8 @@ class XDMFSeries:
         if self.index != self.path and self.comm.rank == 0 and since is not None:
             earlier = series.earlier_grids(self.index, since)
         self._earlier = earlier
-        self.writer = SeriesWriter(msh, self.path.with_suffix(".h5"), self.index, earlier)
+        with _stderr_held_back():
+            self.writer = SeriesWriter(msh, self.path.with_suffix(".h5"), self.index, earlier)
 
     @property
     def segments(self) -> list:
@@ -170,8 +171,9 @@ class XDMFSeries:
         if error:
             raise error
         try:
-            self.writer.write(functions, t,
-                              lambda path, xml: atomic_write_bytes(path, lambda f: f.write(xml)))
+            with _stderr_held_back():  # HDF5's error stack: shown only if the write succeeds
+                self.writer.write(functions, t, lambda path, xml: atomic_write_bytes(
+                    path, lambda f: f.write(xml)))
         except (ValueError, KeyError, TypeError) as exc:  # h5py's own, on rank 0
             raise OSError(f"{self.path.with_suffix('.h5').name}: {exc}") from None
 
@@ -208,9 +210,9 @@ def _parses(path) -> bool:
         return False
 
 
-#: XDMF files whose close failed: DOLFINx 0.5 / HDF5 crash (SIGSEGV) when such a file is
-#: destroyed or when HDF5 shuts down, so they are kept alive and the command line ends the
-#: process with os._exit (cli.py) when this list is not empty
+#: HDF5 files (h5py, DOLFINx) whose write or close failed: HDF5 crashes (SIGSEGV) when such a
+#: file is destroyed or when HDF5 shuts down, so they are kept alive and the command line ends
+#: the process with os._exit (cli.py) when this list is not empty
 FAILED_HDF5_FILES = []
 
 

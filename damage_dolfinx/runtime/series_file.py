@@ -203,6 +203,28 @@ def index_xml(pieces) -> bytes:
             + b"    </Grid>\n  </Domain>\n</Xdmf>\n")
 
 
+def _room_for(path, need, replace=False):
+    """OSError before HDF5 starts a write that the file-size limit (RLIMIT_FSIZE) would cut:
+    HDF5 left with a half-written file crashes the process later."""
+    import errno
+    import resource
+    limit = resource.getrlimit(resource.RLIMIT_FSIZE)[0]
+    if limit == resource.RLIM_INFINITY:
+        return
+    size = 0 if replace or not Path(path).exists() else Path(path).stat().st_size
+    if size + need > limit:
+        raise OSError(errno.EFBIG, f"File too large (the process's file-size limit is "
+                                   f"{limit // 1024} kB; {Path(path).name} would need "
+                                   f"~{(size + need) // 1024} kB)")
+
+
+def _keep_failed(f):
+    """A file whose write or close failed is never closed or destroyed again (HDF5 crashes
+    doing so); the command line then ends the process without HDF5's shutdown."""
+    from damage_dolfinx.runtime.io import FAILED_HDF5_FILES
+    FAILED_HDF5_FILES.append(f)
+
+
 class SeriesWriter:
     """The segment ``h5path`` of the run's series and the index ``index`` (fields.xdmf) that
     lists ``earlier`` grids [(t, Grid)] (kept from the runs before a restart) then this
@@ -214,9 +236,16 @@ class SeriesWriter:
         self.earlier, self.grids, self.count = list(earlier), [], 0
         self._earlier_xml = [grid_xml(g) for _, g in self.earlier] if self.comm.rank == 0 else []
         if self.comm.rank == 0:
-            with h5_open(self.h5path, "w") as f:
+            _room_for(self.h5path, self.order.geometry.nbytes + self.order.topology.nbytes
+                      + 65536, replace=True)
+            f = h5_open(self.h5path, "w")
+            try:
                 f.create_dataset("/Mesh/geometry", data=self.order.geometry)
                 f.create_dataset("/Mesh/topology", data=self.order.topology.astype(np.int64))
+                f.close()
+            except BaseException:
+                _keep_failed(f)
+                raise
 
     def write(self, functions, t, atomic_write):
         """Append ``functions`` at time ``t`` (a time already written by this segment is
@@ -229,12 +258,18 @@ class SeriesWriter:
             return  # the restart's own time: the earlier run's grid stays (it was written
             # from the solve itself; a restored state lacks what only a solve gives, such as
             # contact reactions)
+        _room_for(self.h5path, sum(v.nbytes + 2048 for *_, v in gathered) + 16384)
         attributes = []
-        with h5_open(self.h5path, "a") as f:
+        f = h5_open(self.h5path, "a")
+        try:
             for name, center, kind, values in gathered:
                 path = f"/Function/{name}/{self.count}"
                 f.create_dataset(path, data=values)
                 attributes.append((name, center, kind, path, values.shape))
+            f.close()
+        except BaseException:
+            _keep_failed(f)
+            raise
         self.count += 1
         grid = grid_element(self.order, self.h5path.name, t, attributes)
         self.grids = [(s, g, x) for s, g, x in self.grids if abs(s - float(t)) > tol]
