@@ -47,6 +47,10 @@ def h5_open(path, mode):
         return h5py.File(path, mode, locking=False)
     except TypeError:  # an h5py without the keyword
         return h5py.File(path, mode)
+    except OSError as exc:  # already open in this process with locking (meshio keeps it open):
+        if "locking flag" not in str(exc):  # HDF5 then wants the same flag, and shares the file
+            raise
+        return h5py.File(path, mode)
     except ValueError as exc:
         if "locking" not in str(exc).lower():
             raise OSError(str(exc)) from None
