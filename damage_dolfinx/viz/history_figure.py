@@ -5,15 +5,14 @@ Groups: the damage range (zeta_min, zeta_mean, zeta_max), the iterations (damage
 SNES), the step's wall time, each norm alone, and a model's own columns grouped by name
 (``contact_force_x``/``_y``/``_z`` together). Columns with no number at all are left out.
 Drawn on an explicit ``matplotlib.figure.Figure`` with an Agg canvas inside a local style
-context: the global backend and rcParams of the user's session are never touched.
+context (``figstyle.agg_figure``): the global backend and rcParams of the user's session are
+never touched.
 Pure matplotlib/numpy (rank 0 calls it).
 """
 from __future__ import annotations
 
 import csv
 import math
-from pathlib import Path
-
 import numpy as np
 
 #: what the fixed columns show (label of the panel, unit)
@@ -71,9 +70,7 @@ def _own_label(name, cols) -> str:
 
 def plot_run_history(csv_path, path, title="", ncols=3) -> list:
     """Draw ``history.png`` from ``csv_path``; returns the groups drawn."""
-    import matplotlib
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from damage_dolfinx.viz.figstyle import agg_figure, save_agg
     data = read_columns(csv_path)
     t = data.get("t")
     if t is None or not np.isfinite(t).any():
@@ -85,9 +82,8 @@ def plot_run_history(csv_path, path, title="", ncols=3) -> list:
         return []
     ncols = min(ncols, len(groups))
     nrows = math.ceil(len(groups) / ncols)
-    with matplotlib.rc_context(_STYLE):
-        fig = Figure(figsize=(3.3 * ncols, 2.1 * nrows + 0.5), dpi=150, layout="constrained")
-        FigureCanvasAgg(fig)
+    with agg_figure(_STYLE, figsize=(3.3 * ncols, 2.1 * nrows + 0.5), dpi=150,
+                    layout="constrained") as fig:
         axes = fig.subplots(nrows, ncols, squeeze=False, sharex=True)
         for ax, (name, cols) in zip(axes.flat, groups):
             label, unit = _LABELS.get(name, (_own_label(name, cols), ""))
@@ -113,6 +109,5 @@ def plot_run_history(csv_path, path, title="", ncols=3) -> list:
                 visible[-1].set_xlabel("$t$ [s]")
         if title:
             fig.suptitle(title)
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(path)
+        save_agg(fig, path)
     return groups
