@@ -12,7 +12,7 @@ ROOTS_DIR=${ROOTS_DIR:-/var/cache/damage-dolfinx/roots}
 stack_packages() {
   local dolfinx=python3-dolfinx-real
   [ "$1" = bookworm ] && dolfinx=python3-dolfinx
-  echo "$dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix python3-ffcx" \
+  echo "$dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix python3-ffcx python3-meshio" \
        "python3-gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy python3-venv" \
        "python3-setuptools python3-pip gcc make chromium"
 }

@@ -1,8 +1,9 @@
 """Run by ParaView's own Python (``pvpython pv_read.py RUN_FOLDER OUT_JSON FRAME_PNG``): opens the
 run's ``fields.xdmf`` the way a user does in ParaView (its XDMF reader) and writes what ParaView
-sees: the time steps and, at the last one, every grid of the file (DOLFINx writes one temporal
-grid per function: u, zeta, von Mises ...) with its point coordinates and point arrays, and its
-cell centres and cell arrays, as JSON. It renders the last frame (zeta) to a PNG.
+sees: the time steps and, at the last one, every block of the reader's output (the package
+writes one grid per time holding every field: one block; folders of earlier versions have one
+temporal grid per function) with its point coordinates and point arrays, and its cell centres and
+cell arrays, as JSON. It renders the last frame (zeta on the body deformed by u) to a PNG.
 ``benchmarks/platforms/paraview_check.py`` compares the JSON with the run's own history.csv and
 fields_final.npz. Nothing here imports damage_dolfinx: ParaView's Python is another interpreter."""
 import json
@@ -27,16 +28,27 @@ last = times[-1] if times else 0.0
 reader.UpdatePipeline(last)
 root = servermanager.Fetch(reader)
 
+
+
+def leaves(data):
+    """(name, dataset) of every leaf block; a single dataset is its own one block."""
+    if not hasattr(data, "NewIterator"):
+        return [(None, data)]
+    found = []
+    it = data.NewIterator()
+    it.InitTraversal()
+    while not it.IsDoneWithTraversal():
+        found.append((it.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME()),
+                      it.GetCurrentDataObject()))
+        it.GoToNextItem()
+    return found
+
+
 grids = {}
-index = 0
-it = root.NewIterator()
-it.InitTraversal()
-while not it.IsDoneWithTraversal():
-    block = it.GetCurrentDataObject()
+for index, (name, block) in enumerate(leaves(root)):
     wrapped = dsa.WrapDataObject(block)
-    name = it.GetCurrentMetaData().Get(vtkCompositeDataSet.NAME()) or \
-        "+".join(list(wrapped.PointData.keys()) + list(wrapped.CellData.keys())) or f"block{index}"
-    index += 1
+    name = name or "+".join(list(wrapped.PointData.keys()) + list(wrapped.CellData.keys())) \
+        or f"block{index}"
     cc = vtkCellCenters()
     cc.SetInputData(block)
     cc.Update()
@@ -44,21 +56,17 @@ while not it.IsDoneWithTraversal():
                    "point_arrays": {k: wrapped.PointData[k].tolist() for k in wrapped.PointData.keys()},
                    "cell_centres": dsa.WrapDataObject(cc.GetOutput()).Points.tolist(),
                    "cell_arrays": {k: wrapped.CellData[k].tolist() for k in wrapped.CellData.keys()}}
-    it.GoToNextItem()
 
 with open(out_json, "w") as f:
     json.dump({"reader": reader.GetXMLName(), "times": times, "grids": grids}, f)
 
 # one frame as a user would look at it: zeta at the last time step, on [min, 1], on the body
-# deformed by u (factor 1). DOLFINx writes one grid per function on the same mesh: zeta's grid
-# gets u's point array (same points, same order) and is shown alone.
+# deformed by u (factor 1). zeta's block gets u's point array when u is in another block of the
+# same points (earlier versions' one grid per function) and is shown alone.
 blocks = {}
-it.InitTraversal()
-while not it.IsDoneWithTraversal():
-    b = it.GetCurrentDataObject()
+for _, b in leaves(root):
     for k in dsa.WrapDataObject(b).PointData.keys():
         blocks[k] = b
-    it.GoToNextItem()
 view = simple.GetActiveViewOrCreate("RenderView")
 view.ViewSize = [900, 700]
 try:
@@ -70,7 +78,8 @@ view.OrientationAxesVisibility = 0
 if "zeta" in blocks:
     body = blocks["zeta"].NewInstance()
     body.DeepCopy(blocks["zeta"])
-    if "u" in blocks and blocks["u"].GetNumberOfPoints() == body.GetNumberOfPoints():
+    if "u" in blocks and blocks["u"] is not blocks["zeta"] and \
+            blocks["u"].GetNumberOfPoints() == body.GetNumberOfPoints():
         body.GetPointData().AddArray(blocks["u"].GetPointData().GetArray("u"))
     source = simple.TrivialProducer()
     source.GetClientSideObject().SetOutput(body)

@@ -8,6 +8,11 @@
     run.integral("v", t=0.5)                                     # int_Omega v dx (per component)
     run.final["zeta"]                                            # fields_final.npz
 
+Read-back never lies: a time outside the stored range (or NaN, an infinity, a non-number) is
+refused with the range in the message, and a damaged or partial file (cut short, bad XML, JSON,
+CSV or NPZ) gives one InputError naming the file. Reading never disturbs a run writing the folder:
+HDF5 files are opened without file locking.
+
 Fields come in the rank-independent order of ``fields_final.npz`` (nodes, or cell midpoints for
 cell fields, sorted by x, then y (then z)), so a run made on any number of ranks, restarted or
 not, reads back the same arrays. Reading fields needs h5py (installed by ``make setup``).
@@ -17,6 +22,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Union
@@ -44,7 +50,16 @@ class RunResults:
         path = self.folder / "summary.json"
         if not path.is_file():
             raise InputError(f"{str(self.folder)!r} holds no run (no summary.json)")
-        self.summary = json.loads(path.read_text())
+        try:
+            self.summary = json.loads(path.read_text(encoding="utf-8"))
+        except (ValueError, UnicodeDecodeError) as exc:  # JSONDecodeError is a ValueError
+            raise InputError(f"cannot read {str(path)!r}: not valid JSON ({exc}): the file is "
+                             "damaged or was cut short") from None
+        except OSError as exc:
+            raise InputError(f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
+        if not isinstance(self.summary, dict):
+            raise InputError(f"cannot read {str(path)!r}: not a run summary (a JSON "
+                             f"{type(self.summary).__name__}, not an object)")
         self.history = _history(self.folder / "history.csv")
         self._series = None
 
@@ -68,7 +83,9 @@ class RunResults:
         return list(self.series.names)
 
     def field(self, name: str, t: float = None) -> Field:
-        """Field ``name`` at the stored time nearest ``t`` (default: the last one)."""
+        """Field ``name`` at the stored time nearest ``t`` (default: the last one). A time
+        outside the stored range, NaN, an infinity or a non-number is refused (InputError,
+        naming the range); a damaged file gives an InputError naming it."""
         coords, values, t_found = self.series.field(name, t)
         return Field(name, t_found, coords, values)
 
@@ -83,25 +100,40 @@ class RunResults:
         path = self.folder / "fields_final.npz"
         if not path.is_file():
             return {}
-        with np.load(path) as data:
-            return dict(data)
+        try:
+            with np.load(path) as data:
+                return dict(data)
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile, KeyError) as exc:
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise InputError(f"cannot read {str(path)!r}: {reason}: the file is damaged or "
+                             "was cut short") from None
 
 
 def _history(path) -> dict:
     """history.csv as column -> float array (NaN where a row has no value)."""
     if not path.is_file():
         return {}
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+    try:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+    except (csv.Error, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read {str(path)!r}: not a CSV table ({exc}): the file is "
+                         "damaged") from None
+    except OSError as exc:
+        raise InputError(f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
     if not rows:
         return {}
+    header = [c for c in rows[0] if c is not None]
+    if "t" not in header:
+        raise InputError(f"cannot read {str(path)!r}: no column 't' in its header (columns: "
+                         f"{', '.join(map(str, header[:8]))}): not a run's history")
 
     def number(text):
         try:
             return float(text)
         except (TypeError, ValueError):
             return np.nan
-    return {c: np.array([number(r.get(c)) for r in rows]) for c in rows[0]}
+    return {c: np.array([number(r.get(c)) for r in rows]) for c in header}
 
 
 def read_run(folder: "Union[str, os.PathLike[str]]") -> RunResults:

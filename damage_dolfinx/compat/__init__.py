@@ -37,6 +37,7 @@ from damage_dolfinx.compat.meshes import (  # noqa: E402,F401
     locate_entities_boundary,
     locate_entities, geometry_dofmap, cell_diameters, meshtags, cell_midpoints, num_owned_cells,
     cell_vertex_coords, cell_dofs, model_to_mesh, xdmf_file, read_msh,
-    dofs_in_cells, facet_coords, facet_vertex_coords)
+    dofs_in_cells, facet_coords, facet_vertex_coords, geometry_input_indices, num_owned_nodes,
+    dofmap_array, cell_type_name)
 from damage_dolfinx.compat.petsc import (  # noqa: E402,F401
     PETSC_UNLIMITED, petsc_option_used)

@@ -195,3 +195,29 @@ def facet_vertex_coords(msh, facets):
         cpp_mesh = getattr(msh, "_cpp_object", getattr(msh, "_mesh", msh))
         nodes = dolfinx.cpp.mesh.entities_to_geometry(cpp_mesh, 1, facets, False)
     return msh.geometry.x[nodes][:, :, :2]
+
+
+def geometry_input_indices(msh) -> np.ndarray:
+    """For every local geometry node (owned, then ghosts) its index in the input data the mesh
+    was created from (the generator's or the file's node order: independent of the number of
+    ranks); the same property on 0.5 to 0.11."""
+    return np.asarray(msh.geometry.input_global_indices, dtype=np.int64)
+
+
+def num_owned_nodes(msh) -> int:
+    """Geometry nodes owned by this rank (the first ones of ``msh.geometry.x``)."""
+    imap = msh.geometry.index_map
+    return int((imap() if callable(imap) else imap).size_local)
+
+
+def dofmap_array(V) -> np.ndarray:
+    """(n_local_cells, ndofs_per_cell) local (block) dof indices of all local cells, owned then
+    ghosts (0.5's AdjacencyList, the array of later versions)."""
+    dl = V.dofmap.list
+    return np.asarray(dl.array.reshape(-1, dl.links(0).size) if hasattr(dl, "array") else dl)
+
+
+def cell_type_name(msh) -> str:
+    """The cell type's name: 'triangle', 'tetrahedron', 'quadrilateral', ..."""
+    ct = msh.topology.cell_type
+    return getattr(ct, "name", str(ct).rsplit(".", 1)[-1])

@@ -126,61 +126,56 @@ class CSVHistory:
 
 
 class XDMFSeries:
-    """XDMF/HDF5 time series of several fields on one mesh, for ParaView. A failed write (full
-    disk) raises RuntimeError with one line: HDF5's own error stack is held back (shown only if
-    the write succeeds anyway), and the file object whose close failed is never destroyed
-    (DOLFINx 0.5 crashes closing it a second time)."""
+    """The run's time series of several fields on one mesh (series_file.py: one grid per output
+    time with every field, the nodes in a rank-independent order, for ParaView, meshio and
+    ``read_run``). A failed write (full disk) raises OSError with one line on rank 0, which
+    ``atomic.collective`` turns into an OutputError on every rank."""
 
     def __init__(self, path, msh, index=None, since=None):
-        """A new series at ``path``; with ``index`` (a restart's segment) the run's index file,
-        whose time steps t < ``since`` are kept before this segment's (series.py)."""
+        """A new series at ``path`` (its data in ``path`` with .h5); with ``index`` (a
+        restart's segment) the run's index file, whose time grids t <= ``since`` are kept before
+        this segment's (series.py). Collective."""
+        from damage_dolfinx.runtime.series_file import SeriesWriter
         self.path, self.comm = Path(path), msh.comm
-        self.index, self._earlier = (Path(index) if index else None), None
-        if self.index is not None and self.index != self.path and self.comm.rank == 0:
-            self._earlier = series.earlier_steps(self.index, since)
-        f = compat.xdmf_file(self.comm, self.path, "w")
-        with _failed_files_kept(f), _stderr_held_back():
-            with f:
-                f.write_mesh(msh)
+        self.index = Path(index) if index else self.path
+        earlier = []
+        if self.index != self.path and self.comm.rank == 0 and since is not None:
+            earlier = series.earlier_grids(self.index, since)
+        self._earlier = earlier
+        with _stderr_held_back():
+            self.writer = SeriesWriter(msh, self.path.with_suffix(".h5"), self.index, earlier)
 
     @property
     def segments(self) -> list:
         """The .h5 files the run's series references (rank 0; [] elsewhere)."""
         if self.comm.rank != 0:
             return []
-        names = [] if self._earlier is None else series.data_files(self._earlier)
+        names = series.data_files(self._earlier)
         return names + [n for n in [self.path.stem + ".h5"] if n not in names]
 
     def write(self, functions, t: float):
-        """Append the fields at ``t``. DOLFINx rewrites the whole XML file in place, so a copy
-        of it (``.xdmf.bak``) exists while it does: a run killed then leaves a complete
-        previous XML, which ``repair_xdmf`` puts back."""
-        backup, error = self.path.with_name(self.path.name + ".bak"), None
-        need = 65536 + 2 * sum(fn.function_space.dofmap.index_map.size_global * 8 * (
-            fn.function_space.dofmap.index_map_bs) + 4096 for fn in functions)
+        """Append the fields at ``t`` (collective); the index XML is replaced atomically after
+        the data is on disk, so it never names data that is not there."""
+        error = None
         if self.comm.rank == 0:
-            try:  # a write that fails half-way can leave ranks inside collective HDF5 calls
+            need = 65536 + 2 * sum(fn.function_space.dofmap.index_map.size_global * 8 * (
+                fn.function_space.dofmap.index_map_bs) + 4096 for fn in functions)
+            try:  # refused before any rank enters the gather
                 free = shutil.disk_usage(self.path.parent).free
-                need += 2 * self.path.stat().st_size
                 if free < need:
                     raise OSError(errno.ENOSPC, f"No space left on device ({free // 1024} kB "
                                                 f"free, the output needs ~{need // 1024} kB)")
-                shutil.copyfile(self.path, backup)
             except OSError as exc:
                 error = exc
-        error = self.comm.bcast(error, root=0)  # every rank stops before the collective open
+        error = self.comm.bcast(error, root=0)
         if error:
             raise error
-        f = compat.xdmf_file(self.comm, self.path, "a")
-        with _failed_files_kept(f), _stderr_held_back():
-            with f:
-                for fn in functions:
-                    f.write_function(fn, t)
-        if self.comm.rank == 0:
-            backup.unlink()
-            if self._earlier is not None:  # the run's index: earlier segments + this one
-                xml = series.index_xml(self._earlier, self.path)
-                atomic_write_bytes(self.index, lambda f: f.write(xml))
+        try:
+            with _stderr_held_back():  # HDF5's error stack: shown only if the write succeeds
+                self.writer.write(functions, t, lambda path, xml: atomic_write_bytes(
+                    path, lambda f: f.write(xml)))
+        except (ValueError, KeyError, TypeError) as exc:  # h5py's own, on rank 0
+            raise OSError(f"{self.path.with_suffix('.h5').name}: {exc}") from None
 
 
 def series_outputs(xdmf) -> dict:
@@ -215,10 +210,8 @@ def _parses(path) -> bool:
         return False
 
 
-#: XDMF files whose close failed: DOLFINx 0.5 / HDF5 crash (SIGSEGV) when such a file is
-#: destroyed or when HDF5 shuts down, so they are kept alive and the command line ends the
-#: process with os._exit (cli.py) when this list is not empty
-FAILED_HDF5_FILES = []
+#: HDF5 files whose write or close failed, kept alive (series_file.py, the same list)
+from damage_dolfinx.runtime.series_file import FAILED_HDF5_FILES  # noqa: E402
 
 
 @contextlib.contextmanager

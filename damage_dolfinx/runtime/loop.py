@@ -17,7 +17,7 @@ from damage_dolfinx.core.parameters import InputError
 from damage_dolfinx.runtime import checkpoint, io
 from damage_dolfinx.runtime.cases import resolve
 from damage_dolfinx.runtime.guards import Progress, solver_step
-from damage_dolfinx.runtime.records import RunRecords
+from damage_dolfinx.runtime.records import HISTORY_FIGURE, RunRecords
 from damage_dolfinx.runtime.runfolder import (RunLock, check_mesh_file, claim_folder,
                                               previous_run)
 from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS, Step
@@ -113,7 +113,8 @@ class Run(RunRecords):
                    self.xdmf_name + ".bak", "fields.xdmf", "fields.xdmf.tmp", "fields_final.npz",
                    "checkpoint.json",
                    *checkpoint.GENERATIONS, *(fig.filename for fig in ex.figures
-                                               if o["figures"])}
+                                               if o["figures"]),
+                   *([HISTORY_FIGURE] if o["figures"] else [])}
         description = previous["description"] if previous else None
         claim = (self.out, "run", planned, o["restart"], o["overwrite"], comm, description)
         claim_folder(*claim, apply=False)
@@ -338,6 +339,7 @@ class Run(RunRecords):
             for fig in self.ex.figures:
                 if not fig.times:
                     self.figure(fig)
+            self.history_figure()
         self.summary["timings_s"] = dict(getattr(stepper, "timings", {}))
         self.summary.update(status=status, wall_time_s=self.wall_time())
         self.write_summary()

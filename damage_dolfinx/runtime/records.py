@@ -25,6 +25,10 @@ def _is_number(value) -> bool:
         not isinstance(value, (bool, np.bool_))
 
 
+#: the figure of history.csv that every run draws with its other figures
+HISTORY_FIGURE = "history.png"
+
+
 class ColumnError(RuntimeError):
     """A model reported a scalar that no history column takes, or left a declared one out."""
 
@@ -162,6 +166,18 @@ class RunRecords:
                 print(f"damage-dolfinx: figure {filename} not drawn at step {self.stepper.n} "
                       f"(the computation is not affected): {failures[0]}", file=sys.stderr,
                       flush=True)
+
+    def history_figure(self):
+        """history.png: every history.csv column over time (rank 0 draws; collective)."""
+        def draw():
+            add_to_manifest(self.out, [HISTORY_FIGURE], self.comm)
+            if self.comm.rank == 0:
+                from damage_dolfinx.viz.history_figure import plot_run_history
+                plot_run_history(self.out / "history.csv", self.out / HISTORY_FIGURE,
+                                 title=f"{self.ex.id}: history of the run ({self.comm.size} "
+                                       f"rank{'s' if self.comm.size > 1 else ''})")
+            self.summary["outputs"]["figures"].append({"file": HISTORY_FIGURE})
+        io.collective(self.comm, self.out, self.at(HISTORY_FIGURE), draw)
 
     def timed_figures(self):
         """Figures requested at the current time (Figure.times)."""

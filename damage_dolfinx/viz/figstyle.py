@@ -20,6 +20,7 @@ figures (figsetting.py) are modules of their own, reached through this one as we
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 
@@ -339,3 +340,25 @@ def __getattr__(name):
         import importlib
         return getattr(importlib.import_module(f"{__package__}.{_ELSEWHERE[name]}"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+# ------------------------------------------------- figures that leave the session alone
+@contextlib.contextmanager
+def agg_figure(style: dict, **figure_kwargs):
+    """An explicit ``matplotlib.figure.Figure`` on its own Agg canvas, created and drawn inside
+    ``matplotlib.rc_context(style)``: the session's backend and global rcParams are never
+    touched (no pyplot). Save it with :func:`save_agg` inside the ``with`` block."""
+    import matplotlib
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    with matplotlib.rc_context(style):
+        fig = Figure(**figure_kwargs)
+        FigureCanvasAgg(fig)
+        yield fig
+
+
+def save_agg(fig, path):
+    """Write a figure made by :func:`agg_figure` (its folder created if needed)."""
+    from pathlib import Path
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path)
