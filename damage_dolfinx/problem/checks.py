@@ -160,7 +160,9 @@ def _check_parameters_of(params, info, own_law):
     if missing:
         raise InputError(f"params: a ModelParameters without model {info.id}'s data "
                          f"({', '.join(missing)}); start from model_defaults({info.id!r})")
-    foreign = sorted(set(params.extra) - set(own.extra))
+    # the model reads its defaults' data and every datum it has a rule for (Model.data_rules:
+    # its own, e.g. 3.3's initial_damage, and those shared by the models, e.g. history_every)
+    foreign = sorted(set(params.extra) - set(own.extra) - set(info.data_rules()))
     if foreign and not own_law:
         raise InputError(f"params: a ModelParameters with data model {info.id} does not read "
                          f"({', '.join(foreign[:6])}{', ...' if len(foreign) > 6 else ''}): "

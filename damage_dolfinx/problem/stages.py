@@ -22,6 +22,9 @@ def configure(ex, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None
               comm=None):
     """``ex`` (under its reading) as one run has it: validated data, T, k, the mesh level and
     file; InputError otherwise (see :meth:`Problem.configure`)."""
+    if not ex._checked:  # every problem, a catalogue example too, passes the same checks once
+        from damage_dolfinx.problem.checks import check_problem
+        ex = check_problem(ex)
     overrides = dict(overrides or {})
     allow_long = bool(overrides.pop("allow_long", False))
     from damage_dolfinx.models.registry import model as model_info, validate
