@@ -24,7 +24,8 @@ export MPLBACKEND := Agg
 APT_PACKAGES := python3-dolfinx python3-petsc4py python3-mpi4py python3-ufl python3-basix \
     python3-ffcx python3-gmsh python3-h5py python3-meshio gmsh openmpi-bin python3-pytest python3-matplotlib python3-scipy \
     python3-venv python3-setuptools gcc chromium \
-    python3-sphinx python3-myst-parser python3-sphinx-gallery furo libjs-mathjax
+    python3-sphinx python3-myst-parser python3-sphinx-gallery furo libjs-mathjax \
+    python3-nbclient python3-nbformat python3-ipykernel
 # As root (containers, CI runners) apt-get runs directly; otherwise through sudo. `env` carries
 # DEBIAN_FRONTEND through sudo and works without it (an empty $(SUDO) must not leave a bare flag).
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
@@ -42,7 +43,7 @@ setup: $(VENV)/.installed
 # Install the Debian stack only if /usr/bin/python3 cannot already import it.
 system-deps:
 	@if /usr/bin/python3 -c "import dolfinx, petsc4py, mpi4py, ufl, basix, ffcx, gmsh, h5py, meshio, matplotlib, pytest, scipy, \
-	    sphinx, myst_parser, sphinx_gallery, furo" \
+	    sphinx, myst_parser, sphinx_gallery, furo, nbclient, nbformat, ipykernel" \
 	    2>/dev/null && command -v mpirun >/dev/null && command -v chromium >/dev/null \
 	    && [ -f /usr/share/javascript/mathjax/MathJax.js ]; then \
 	  echo "setup: Debian FEniCSx stack present"; \

@@ -4,14 +4,15 @@ Debian's python3-nbclient and python3-ipykernel): ``%matplotlib inline``, the us
 log line appears, and that the backend is the same before and after the run.
 
     python benchmarks/platforms/notebook_session.py [--out DIR]   (writes DIR/session.ipynb)
+
+Needs nbclient, nbformat and ipykernel (Debian's python3-nbclient, python3-nbformat and
+python3-ipykernel; `make setup` installs them on Debian 12).
 """
 import argparse
 import json
 import os
 import sys
 
-import nbformat
-from nbclient import NotebookClient
 
 CELLS = [
     """%matplotlib inline
@@ -34,6 +35,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="results/notebook-session")
     args = ap.parse_args()
+    import nbformat  # here: --help works where nbclient is not installed
+    from nbclient import NotebookClient
     os.makedirs(args.out, exist_ok=True)
     # a kernel of this interpreter (the one that sees the package: its venv), found through
     # JUPYTER_PATH

@@ -240,9 +240,13 @@ def sweep(problem: ProblemLike, out: PathLike, grid: Mapping[str, Sequence[Any]]
 
 
 def _sweep_doc():
+    """studies.sweep's docstring and this call's petsc_options, both without indentation
+    (Python 3.13 and later strip it from docstrings themselves: joined as they come, the two
+    would be indented differently there)."""
+    import inspect
     from damage_dolfinx.studies.sweep import sweep as _sweep  # light: no DOLFINx import
-    return _sweep.__doc__ + """
-    ``petsc_options``: PETSc options of every point's run (this module's docstring)."""
+    return inspect.cleandoc(_sweep.__doc__) + (
+        "\n\n``petsc_options``: PETSc options of every point's run (this module's docstring).")
 
 
 sweep.__doc__ = _sweep_doc()
