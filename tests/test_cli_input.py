@@ -85,3 +85,30 @@ def test_singleton_transports_for_mpi_init_only():
     out = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True,
                          check=True).stdout.split()
     assert out == ["ob1", "None"]
+
+
+@pytest.mark.parametrize("api, args", [
+    ({"k": float("nan")}, ["--k", "nan"]),
+    ({"T": float("inf")}, ["--T", "inf"]),
+    ({"k": 1e-310}, ["--k", "1e-310"]),
+    ({"k": -0.1}, ["--k", "-0.1"]),
+    ({"n": 0}, ["--n", "0"]),
+    ({"history_every": 0}, ["--history-every", "0"]),
+    ({"checkpoint_seconds": float("inf")}, ["--checkpoint-seconds", "inf"]),
+    ({"checkpoint_seconds": 1e-320}, ["--checkpoint-seconds", "1e-320"]),
+])
+def test_one_check_one_message(tmp_path, capsys, api, args):
+    """A bad value given through the API and through the command line is refused by the same
+    rule (core.validation), with the same words: the command line writes the flag."""
+    import traceback
+    import damage_dolfinx as dd
+    from damage_dolfinx.cli.wording import for_command_line
+    with pytest.raises(dd.InputError) as refused:
+        dd.run("2.1-ex1", tmp_path / "api", **api)
+    where = traceback.extract_tb(refused.value.__traceback__)[-1].filename
+    assert where.endswith(os.path.join("core", "validation.py")), where
+    status = cli.main(["run", "2.1-ex1"] + args + ["--out", str(tmp_path / "cli")])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert err.strip() == f"damage-dolfinx: error: {for_command_line(str(refused.value))}", err
+    assert not (tmp_path / "api").exists() and not (tmp_path / "cli").exists()

@@ -140,7 +140,6 @@ def steps(problem: ProblemLike, out: PathLike, *, n: Optional[int] = None,
     any work."""
     from damage_dolfinx.runtime.collective import outcome
     from damage_dolfinx.runtime.loop import Run
-    from damage_dolfinx.runtime.steps import Steps
     from damage_dolfinx.core.validation import check_run, communicator
     with outcome(communicator("comm", comm)):
         checked = check_run(out, comm, n=n, k=k, T=T, restart=restart, overwrite=overwrite,

@@ -77,7 +77,7 @@ from mpi4py import MPI  # noqa: E402
 # the parts, by concept: the arguments (arguments.py), the PETSc options among them
 # (petsc_options.py), what each command does (commands.py); these names are their public face
 from damage_dolfinx.cli.commands import command  # noqa: E402
-from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser  # noqa: F401,E402
+from damage_dolfinx.cli.arguments import _overrides, _parser  # noqa: F401,E402
 from damage_dolfinx.problem.petsc_options import (PETSC_GLOBAL, PETSC_PREFIXES,  # noqa: F401,E402
                                               _check_petsc_values, _forget, _petsc_options,
                                               _unused)

@@ -222,17 +222,3 @@ def _overrides(pairs, friction_solver=None, friction_law=None, reading=None, arg
 #: --reading): given there and by --set as well is given twice
 _SAME_AS_SET = frozenset({"friction_solver", "friction_law", "reading"})
 
-
-def _check_finite(args):
-    """Every number on the command line is finite (argparse's float() accepts 'inf' and 'nan')."""
-    import math
-    import sys
-    from damage_dolfinx.core.parameters import InputError
-    for name, value in vars(args).items():
-        for v in value if isinstance(value, list) else [value]:
-            if isinstance(v, float) and not math.isfinite(v):
-                raise InputError(f"--{name.replace('_', '-')} must be a finite number, got {v}")
-            if isinstance(v, float) and 0 < abs(v) < sys.float_info.min:
-                raise InputError(f"--{name.replace('_', '-')} = {v:g} underflows (below "
-                                 f"{sys.float_info.min:.3g}, the smallest normal number): a "
-                                 "time or a size cannot be that small")

@@ -8,7 +8,7 @@ import sys
 
 from mpi4py import MPI
 
-from damage_dolfinx.cli.arguments import _check_finite, _overrides, _parser
+from damage_dolfinx.cli.arguments import _overrides, _parser
 from damage_dolfinx.problem.petsc_options import _check_petsc_values, _petsc_options, _unused
 
 
@@ -19,7 +19,6 @@ def command(argv, comm, given):
     parser = _parser()
     args, extra = parser.parse_known_args(argv)
     given.update(_petsc_options(extra, parser, args.command))
-    _check_finite(args)
     _check_petsc_values(given)
     handler = _logging(args.log_level, comm)
     try:

@@ -169,7 +169,7 @@ def seconds(name, value):
     """A wall-time interval: a finite number >= 0 (0: never)."""
     if not is_real(value) or not math.isfinite(float(value)) or float(value) < 0:
         raise InputError(f"{name} must be a finite number >= 0 (0: none), got {_shown(value)}")
-    return float(value)
+    return real(name, value, low=0.0)  # and not an underflow
 
 
 def reference_layout(name, value):
