@@ -104,6 +104,7 @@ class ThermalKelvinVoigt(dd.Model):
 
     id = "kv-thermal"
     title = "quasistatic Kelvin-Voigt body with damage and temperature"
+    extra_roles = {"roller": 4}                        # u.nu = 0 on a face (a coordinate plane)
     stability_limit = "explicit elastic term: k <= 2/m_visc"
     checkpoint_fields = ("u", "zeta", "v", "theta")
     history_columns = ("theta_max", "thermal_energy", "heat_source", "heat_outflow", "heat_its")
@@ -151,22 +152,23 @@ class ThermalKelvinVoigt(dd.Model):
         elastic = self.zeta_old * b.Phi_L(b.B(self.eps_e_old, p.E, p.nu), p.L_trunc)
         f_B, f_N = self.loads()
         l = b.load(w, f_B, f_N, ds(2)) - ufl.inner(elastic, b.eps(w)) * ufl.dx
-        self.mech = b.LinearSolver(a, l, [b.clamped(V, tags, 1)], "mech_", self.context,
-                                   constant_matrix=True)
+        bcs = [b.clamped(V, tags, 1)] + b.bilateral(V, tags, 4)
+        self.mech = b.LinearSolver(a, l, bcs, "mech_", self.context, constant_matrix=True)
 
         # (T5) the temperature, backward Euler, matrix assembled once
         self.source = self.heat_source(self.v, self.zeta, self.zeta_old, self.eps_e_old)
         th, eta = ufl.TrialFunction(Z), ufl.TestFunction(Z)
         c, K, h = x["c_heat"], x["K_heat"], x["h_heat"]
+        dA = ufl.Measure("ds", domain=msh)                  # the whole boundary
         a_th = (c / k * th * eta + K * ufl.inner(ufl.grad(th), ufl.grad(eta))) * ufl.dx \
-            + h * th * eta * ufl.ds
+            + h * th * eta * dA
         l_th = (c / k * self.theta_old + self.source) * eta * ufl.dx
         self.heat = b.LinearSolver(a_th, l_th, [], "heat_", self.context, constant_matrix=True)
 
         # the heat balance's terms (T6), and the outputs
         self._energy = fem.form(c * self.theta * ufl.dx)
         self._source = fem.form(self.source * ufl.dx)
-        self._outflow = fem.form(h * self.theta * ufl.ds)
+        self._outflow = fem.form(h * self.theta * dA)
         Q = b.scalar_dg0(msh)
         self.von_mises = fem.Function(Q, name="von_mises")
         sigma = b.viscous_stress(self.v, p.E, p.nu, x["m_visc"]) + self.zeta * b.Phi_L(
@@ -260,7 +262,7 @@ def heat_balance(steps, k):
             visc = ufl.inner(b.B(b.eps(m.v), p.E, p.nu), b.eps(m.v)) / x["m_visc"]
             r = x["beta"] * (visc + psi * ufl.max_value(m.zeta_old - m.zeta, 0.0) / k)
             forms = [fem.form(f) for f in (x["c_heat"] * m.theta * ufl.dx, r * ufl.dx,
-                                           x["h_heat"] * m.theta * ufl.ds)]
+                                           x["h_heat"] * m.theta * ufl.ds(m.mesh))]
             energy_before = total(forms[0])
         energy, source, outflow = (total(f) for f in forms)
         if step.n > 0:
@@ -286,6 +288,86 @@ if RUN:
         print(f"PHYSICS_CHECK heat_balance {balance:.3e} 1e-9 "
               f"{'PASS' if balance <= 1e-9 else 'FAIL'}")
     assert balance <= 1e-9
+
+# %%
+# A uniform case: the scheme in closed form
+# -----------------------------------------
+# The unit square on rollers (:math:`u_1 = 0` at :math:`x_1 = 0`, :math:`u_2 = 0` at
+# :math:`x_2 = 0`, tag 4), pulled by :math:`(q t, 0)` on :math:`x_1 = 1`, insulated
+# (:math:`h = 0`), undamaged at :math:`t = 0`: the stress is uniaxial and every field uniform,
+# which P1 elements hold exactly. The scheme is then a recursion for the strain
+# :math:`\varepsilon_n`, :math:`\zeta_n` and :math:`\theta_n` (the damage step without the gradient,
+# clipped to :math:`[\zeta_*, 1]`; (T4) with :math:`\varepsilon(v_n) = m_{visc}\mathcal{B}^{-1}
+# \bigl(\mathrm{diag}(q t_n, 0) - \zeta_{n-1}\Phi_L(\mathcal{B}\varepsilon_{e,n-1})\bigr)`; (T5)
+# with :math:`\theta_n = \theta_{n-1} + k r_n / c`), written here in NumPy, independently of the
+# finite elements; the run must reproduce it.
+
+def square(comm, n):
+    def rollers(x):
+        return side(0, 0.0)(x) | side(1, 0.0)(x)
+    return rectangle(comm, (0.0, 0.0), (1.0, 1.0), n, n, {4: rollers, 2: side(0, 1.0)})
+
+
+def uniform_recursion(p, x, q, k, steps):
+    """(strain, zeta, theta) after ``steps`` steps of the scheme for the uniform state."""
+    E, nu, m = p.E, p.nu, x["m_visc"]
+
+    def B(e):  # plane stress
+        return E * nu / (1 - nu ** 2) * np.trace(e) * np.eye(2) + E / (1 + nu) * e
+
+    def B_inv(s):
+        return ((1 + nu) * s - nu * np.trace(s) * np.eye(2)) / E
+
+    def phi(e, z):  # the thesis law of variant A, (1.3)
+        ez = min(max(z, p.zeta_star), 1.0)
+        return (p.lam_D * (1 - ez) / ez - 0.5 * p.lam_u * min(np.sum(e * e), p.q_star)
+                - p.lam_w)
+
+    e, z, th = np.zeros((2, 2)), 1.0, 0.0
+    for n in range(1, steps + 1):
+        e_el = e - x["alpha"] * th * np.eye(2)
+        soft = 0.5 * x["s_theta"] * p.lam_u * max(th, 0.0) * min(np.sum(e_el * e_el), p.q_star)
+        z_new = min(max(z + k * (phi(e_el, z) - soft), p.zeta_star), 1.0)
+        stress = np.clip(B(e_el), -p.L_trunc, p.L_trunc)
+        ev = m * B_inv(np.diag([q * n * k, 0.0]) - z * stress)
+        psi = 0.5 * np.sum(stress * e_el)
+        r = x["beta"] * (np.sum(B(ev) * ev) / m + psi * max(z - z_new, 0.0) / k)
+        th += k * r / x["c_heat"]
+        e, z = e + k * ev, z_new
+    return e, z, th
+
+
+def uniform_defect(uniform, out):
+    """Run ``uniform`` (the square on rollers) to its T; the largest relative difference of
+    its strain, damage and temperature from the recursion, and the recursion's values."""
+    with dd.steps(uniform, out, overwrite=True, progress=False, figures=False) as run:
+        for step in run:
+            m = step.model
+    eps_h = fem.Function(b.tensor_dg0(m.mesh))
+    b.interpolate(eps_h, b.expression(b.eps(m.u), b.tensor_dg0(m.mesh)))
+    local = lambda f: f.x.array[:f.function_space.dofmap.index_map.size_local]  # noqa: E731
+    e, z, th = uniform_recursion(m.params, m.params.extra, Q_LOAD, uniform.k,
+                                 m.data.time.num_steps)
+    worst = 0.0
+    for values, exact in ((local(eps_h).reshape(-1, 2, 2), e), (local(m.zeta), z),
+                          (local(m.theta), th)):
+        if values.size:
+            worst = max(worst, float(np.abs(values - exact).max() / np.abs(exact).max()))
+    return comm.allreduce(worst, op=MPI.MAX), (e, z, th)
+
+
+uniform = dd.Problem(model=ThermalKelvinVoigt, mesh=square, n=2, T=1.0, k=0.05,
+                     name="thermal-uniform", params={"h_heat": 0.0},
+                     boundaries={"roller": 4, "traction": 2},
+                     traction=lambda x, t: ufl.as_vector((Q_LOAD * t, 0.0)))
+if RUN:
+    worst, (e, z, th) = uniform_defect(uniform, out / "uniform")
+    if comm.rank == 0:
+        print(f"uniform case at t = {uniform.T:g}: eps_11 = {e[0, 0]:.6g}, zeta = {z:.6g}, "
+              f"theta = {th:.6g} (closed form)")
+        print(f"PHYSICS_CHECK uniform_closed_form {worst:.3e} 1e-9 "
+              f"{'PASS' if worst <= 1e-9 else 'FAIL'}")
+    assert worst <= 1e-9
 
 # %%
 # What the temperature does to the damage

@@ -1,7 +1,8 @@
 """The worked temperature model (demos/demo_thermal_damage.py: a Kelvin-Voigt body with damage
 and a temperature with its own heat equation): it passes dd.check_model (serially and against
 2 ranks), its discrete heat balance holds to solver tolerance and fails for a heat step run
-before the velocity step, and the temperature left out of the state is refused or caught."""
+before the velocity step, a uniform case follows the scheme's recursion and fails for a damage
+source of the total strain, and the temperature left out of the state is refused or caught."""
 import dataclasses
 import runpy
 from pathlib import Path
@@ -13,6 +14,7 @@ import damage_dolfinx as dd
 DEMO = Path(__file__).resolve().parent.parent / "demos" / "demo_thermal_damage.py"
 NS = runpy.run_path(str(DEMO), run_name="thermal_check")   # the model and problem, no run
 Thermal, PROBLEM, heat_balance = NS["ThermalKelvinVoigt"], NS["problem"], NS["heat_balance"]
+UNIFORM, uniform_defect = NS["uniform"], NS["uniform_defect"]
 SHORT = dict(n=2, T=0.5)   # 10 steps of k = 0.05 on the 8 x 2 bar: damage and heat under way
 
 
@@ -55,6 +57,27 @@ def test_heat_balance_holds_and_catches_a_heat_step_out_of_order(tmp_path):
     assert produced > 0.05 and rows[-1][3] < 0.99    # heat made, damage under way
     assert balance <= 1e-9
     wrong, _ = balance_of(dataclasses.replace(PROBLEM, model=HeatTooEarly), tmp_path / "wrong")
+    assert wrong > 1e-3, wrong
+
+
+class TotalStrainDamage(Thermal):
+    """A planted mistake: the damage source of the total strain (thermal expansion damages)."""
+    id = "kv-thermal-total-strain-damage"
+
+    def damage_source(self, e, z):
+        import ufl
+        p, x = self.params, self.params.extra
+        psi_q = ufl.min_value(ufl.inner(e, e), p.q_star)
+        return (dd.Model.damage_source(self, e, z)
+                - 0.5 * x["s_theta"] * p.lam_u * ufl.max_value(self.theta_old, 0.0) * psi_q)
+
+
+def test_uniform_case_follows_the_recursion_and_catches_thermal_strain_damage(tmp_path):
+    defect, (e, z, theta) = uniform_defect(UNIFORM, tmp_path / "right")
+    assert theta > 1.0 and z < 0.9    # heated and damaged
+    assert defect <= 1e-9
+    wrong, _ = uniform_defect(dataclasses.replace(UNIFORM, model=TotalStrainDamage),
+                              tmp_path / "wrong")
     assert wrong > 1e-3, wrong
 
 
