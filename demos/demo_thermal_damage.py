@@ -70,7 +70,7 @@ heating), and the damage source grows with :math:`\theta_+` (thermal softening, 
 checkpointed and checked after every step, and the damage step declares that it reads
 :math:`\theta_{n-1}` (the contracts then refuse an ``old_state`` without it).
 
-The physics check is the discrete heat balance: (T5) with :math:`\eta = 1` (a P1 function) gives
+Two physics checks. The discrete heat balance: (T5) with :math:`\eta = 1` (a P1 function) gives
 
 .. math::
 
@@ -79,7 +79,10 @@ The physics check is the discrete heat balance: (T5) with :math:`\eta = 1` (a P1
 
 evaluated here at every step from the live fields with forms of the script's own, summed over
 the run, and compared relative to the heat produced: it holds to the heat solver's tolerance
-and fails when the temperature step does not solve (T5) with the source of this step.
+and fails when the temperature step does not solve (T5) with the source of this step. And a
+uniform case (an insulated square on rollers in uniaxial tension), where the scheme is a
+recursion of a few numbers, written in NumPy independently of the finite elements: the strain,
+damage and temperature of the run must follow it to round-off.
 """
 
 # %%
