@@ -123,6 +123,9 @@ class WearingKelvinVoigt(dd.Model):
     state_bounds = {"w": (0.0, np.inf)}
     history_columns = ("wear_volume", "wear_power", "normal_force", "friction_its")
     contact_quadrature_degree = 2          # the pressure is P1 on Gamma_C: exact
+    rules = {"k_w": (lambda v: v >= 0, "(wear coefficient) must be >= 0"),
+             "mu": (lambda v: v >= 0, "(friction coefficient) must be >= 0"),
+             "eps_reg": (lambda v: v > 0, "(friction regularisation) must be positive")}
 
     @classmethod
     def defaults(cls):
@@ -146,12 +149,12 @@ class WearingKelvinVoigt(dd.Model):
         tags = data.geometry.facet_tags
         ds = ufl.Measure("ds", domain=msh, subdomain_data=tags)
         self.dsC, self.nu = ds(3), ufl.FacetNormal(msh)
-        self.c_nu, self.gap0 = x["c_nu"], x["gap0"]
+        self.c_nu, self.gap0, self.k_w = x["c_nu"], x["gap0"], float(x["k_w"])
         self.damage = self.obstacle_damage_step()                                     # (W2)
         # (W3): the normal compliance implicit in v_n (linear: Gamma_C stays in contact)
         dv, z = ufl.TrialFunction(V), ufl.TestFunction(V)
         nu, c, k = self.nu, self.c_nu, self.k
-        gap = self.gap0 + self.w                          # the worn gap g_0 + w_n
+        gap = self.gap()
         a = (ufl.inner(b.viscous_stress(dv, p.E, p.nu, x["m_visc"]), b.eps(z)) * ufl.dx
              + k * c * ufl.dot(dv, nu) * ufl.dot(z, nu) * self.dsC)
         l = (-ufl.inner(b.damaged_elastic_stress(self.u_old, self.zeta_old, p.E, p.nu,
@@ -175,6 +178,10 @@ class WearingKelvinVoigt(dd.Model):
         self._vm = b.expression(b.von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.w, self.von_mises]
 
+    def gap(self):
+        """The gap of (W3): g_0 + w_n, of the wear Function (so updated at every step)."""
+        return self.gap0 + self.w
+
     def pressure(self, u, w):
         """p_nu(u, w) = c_nu (u.nu - g_0 - w)_+ (UFL)."""
         return b.normal_compliance_pressure(u, self.nu, self.c_nu, self.gap0 + w)
@@ -182,14 +189,13 @@ class WearingKelvinVoigt(dd.Model):
     def contact_pressure(self):
         return self.pressure(self.u, self.w)
 
-    def wear_rate(self, u, w, v):
-        """k_w p_nu(u, w) |v_tau| at the nodes of Gamma_C."""
-        x = self.params.extra
-        return self.nodes.values(("rate", id(u), id(w)),
-                                 x["k_w"] * self.pressure(u, w) * abs(ufl.dot(v, self._tau)))
+    def slip_power(self, u, w, v):
+        """p_nu(u, w) |v_tau| at the nodes of Gamma_C (the wear rate over k_w)."""
+        return self.nodes.values(("power", id(u), id(w)),
+                                 self.pressure(u, w) * abs(ufl.dot(v, self._tau)))
 
     def wear_step(self):                                                              # (W1)
-        rate = self.wear_rate(self.u_old, self.w_old, self.v)   # v: still v_{n-1} here
+        rate = self.k_w * self.slip_power(self.u_old, self.w_old, self.v)  # v: still v_{n-1}
         self.w.x.array[self.nodes.dofs] = self.w_old.x.array[self.nodes.dofs] + self.k * rate
         self.w.x.scatter_forward()
 
@@ -210,8 +216,7 @@ class WearingKelvinVoigt(dd.Model):
                            ("snes_its", "friction_its")))
 
     def scalars(self):
-        x = self.params.extra
-        power = self.wear_rate(self.u, self.w, self.v) / x["k_w"]     # p_nu |v_tau| at t_n
+        power = self.slip_power(self.u, self.w, self.v)               # at t_n
         total = self.comm.allreduce(float(self.nodes.m @ power), op=MPI.SUM)
         return {**super().scalars(), "wear_volume": self.nodes.integral(self.w),
                 "wear_power": total, "normal_force": -float(self.contact_resultant()[1])}
