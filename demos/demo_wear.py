@@ -284,7 +284,9 @@ def run_with_balances(problem, folder, keep=()):
 # The worn volume against :math:`k_w \sum_m k \int_{\Gamma_C} p_\nu |v_\tau|` (at every
 # step), the foundation's force against the load at the end, and the worn volume against
 # Archard's :math:`k_w N s` for the distance slid after the first step (the wear of a step
-# uses the previous step's slip rate).
+# uses the previous step's slip rate). Archard's number holds for a block that slides at the
+# drive's speed everywhere: it does so after the elastic shear of the first steps (measured
+# 0.7 % off; 2 % allowed). The two balances hold to round-off and to the solver's tolerance.
 
 if __name__ == "__main__" or "DAMAGE_DOLFINX_DEMO_OUT" in os.environ:
     out = Path(os.environ.get("DAMAGE_DOLFINX_DEMO_OUT", "results")) / "wear"
@@ -312,28 +314,27 @@ if __name__ == "__main__" or "DAMAGE_DOLFINX_DEMO_OUT" in os.environ:
     # The worn depth along :math:`\Gamma_C` grows fastest at the leading edge, where the
     # moment of friction and drive presses hardest. The block sinks and tilts into the worn
     # foundation: on this compliant foundation the opened gap is taken up by the body's motion,
-    # and the pressure (right axis: after the first step with friction, dotted, and at the
-    # end, dashed), fixed by the balance of forces and moments, hardly changes.
+    # and the pressure (below: after the first step with friction, dotted, and at the end,
+    # dashed), fixed by the balance of forces and moments, hardly changes.
     if comm.rank == 0:
         import matplotlib.pyplot as plt
-        fig, ax = plt.subplots(figsize=(6.0, 3.6))
-        pax = ax.twinx()
+        fig, (ax, pax) = plt.subplots(2, 1, figsize=(6.0, 5.0), sharex=True,
+                                      gridspec_kw={"height_ratios": [3, 2]})
         times = sorted(profiles)
         for i, t in enumerate(times):
             X, w, p = profiles[t]
             ax.plot(X, w, "-", color=plt.cm.viridis(i / max(len(times) - 1, 1)),
-                    label=f"$w$ at $t = {t:.2g}$")
+                    label=f"$t = {t:.2g}$")
         for t, style in ((times[0], ":"), (times[-1], "--")):
             X, w, p = profiles[t]
-            pax.plot(X, p, style, color="C3", label=f"$p_\\nu$ at $t = {t:.2g}$")
-        ax.set_xlabel("$x$ along $\\Gamma_C$")
+            pax.plot(X, p, style, color="C3", label=f"$t = {t:.2g}$")
         ax.set_ylabel("worn depth $w$")
-        pax.set_ylabel("contact pressure $p_\\nu$", color="C3")
         ax.set_ylim(bottom=0.0)
+        ax.legend(fontsize=8, loc="upper left")
+        ax.set_title("Archard wear under a block dragged to the right")
+        pax.set_xlabel("$x$ along $\\Gamma_C$")
+        pax.set_ylabel("pressure $p_\\nu$")
         pax.set_ylim(bottom=0.0)
-        lines = ax.get_legend_handles_labels()
-        plines = pax.get_legend_handles_labels()
-        ax.legend(lines[0] + plines[0], lines[1] + plines[1], fontsize=8, loc="upper left")
-        ax.set_title("Archard wear under a dragged block")
+        pax.legend(fontsize=8, loc="lower right")
         fig.tight_layout()
         fig.savefig(out / "wear_profile.png", dpi=120)
