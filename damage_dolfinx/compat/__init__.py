@@ -25,7 +25,7 @@ DOLFINX_VERSION = dolfinx.__version__
 ScalarType = getattr(dolfinx, "default_scalar_type", PETSc.ScalarType)
 
 from damage_dolfinx.compat.spaces import (  # noqa: E402,F401
-    function_space, element_degree, affine_simplex, is_discontinuous, scalar_p1, vector_p1,
+    function_space, settle_coordinate_element, element_degree, affine_simplex, is_discontinuous, scalar_p1, vector_p1,
     scalar_dg0, tensor_dg0, facet_vertex_quadrature, interpolation_points, expression,
     eval_expression, interpolate, locate_points)
 from damage_dolfinx.compat.assembly import (  # noqa: E402,F401

@@ -10,8 +10,29 @@ import dolfinx
 from dolfinx import fem
 
 
+def settle_coordinate_element(msh):
+    """Give the mesh's UFL coordinate element the equispaced variant FFCx 0.5 gives it in place
+    the first time it compiles a form on the mesh (ffcx.analysis). That rewrite changes the
+    repr, hence the hash, of every UFL Argument made afterwards on the mesh's spaces, and UFL
+    refuses a form holding an Argument made before it and one made after ("Found different
+    Arguments with same number and part", e.g. a solver built again from forms already
+    compiled, with test functions of its own). Done when a space is made (before its
+    Arguments), the first compile changes nothing. A no-op where the element already has a
+    variant and on later versions (basix.ufl coordinate elements)."""
+    domain = msh.ufl_domain()
+    element = getattr(domain, "_ufl_coordinate_element", None)
+    sub = getattr(element, "_sub_element", None)
+    if (not isinstance(element, getattr(ufl, "VectorElement", ())) or sub is None
+            or getattr(sub, "_variant", "") is not None):
+        return
+    domain._ufl_coordinate_element = ufl.VectorElement(ufl.FiniteElement(
+        sub.family(), sub.cell(), sub.degree(), sub.quadrature_scheme(), variant="equispaced"))
+
+
 def function_space(msh, family: str, degree: int, shape: tuple = ()):
-    """Lagrange/DG space with value shape () (scalar), (gdim,) (vector) or (gdim, gdim)."""
+    """Lagrange/DG space with value shape () (scalar), (gdim,) (vector) or (gdim, gdim); the
+    mesh's coordinate element settled first (:func:`settle_coordinate_element`)."""
+    settle_coordinate_element(msh)
     if hasattr(fem, "functionspace"):  # 0.7+
         return fem.functionspace(msh, (family, degree, shape) if shape else (family, degree))
     cell = msh.ufl_cell()
