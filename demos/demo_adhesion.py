@@ -113,7 +113,7 @@ class AdhesiveKelvinVoigt(dd.Model):
         p = dd.model_defaults("2.2")
         return dataclasses.replace(p, E=1000.0, extra={
             "m_visc": 10.0, "c_nu": 1e4, "gamma_nu": 1e3, "eps_a": 0.01, "L_adh": 1.0,
-            "beta0": 1.0, "q": 20.0})
+            "beta0": 1.0})
 
     @classmethod
     def k_max(cls, params):
@@ -236,7 +236,7 @@ def block(comm, n):
                      {4: side(0, 0.0), 2: side(1, 0.25), 3: side(1, 0.0)})
 
 
-Q_LOAD = AdhesiveKelvinVoigt.defaults().extra["q"]
+Q_LOAD = 20.0          # the total pull at t = 1
 
 
 def pull(q=Q_LOAD):
