@@ -150,6 +150,9 @@ class AdhesiveKelvinVoigt(dd.Model):
         sigma = b.kelvin_voigt_stress(v, self.u, self.zeta, p.E, p.nu, x["m_visc"], p.L_trunc)
         self._vm = b.expression(b.von_mises(sigma), Q)
         self.output_fields = [self.u, self.v, self.zeta, self.beta, self.von_mises]
+        # errors of a convergence study: beta in the L2 norm of Gamma_C, where it lives
+        self.error_components = [("u", self.u, "V"), ("zeta", self.zeta, "L2"),
+                                 ("beta", self.beta, "L2_GammaC")]
 
     def _gamma_c_nodes(self, Z, V, tags):
         """The local dofs of beta at the nodes of Gamma_C (owned and ghost) and their nodal
