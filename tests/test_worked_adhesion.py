@@ -83,3 +83,23 @@ def test_beta_left_out_of_the_checkpoint_fails_the_restart_check():
     # restarted with beta never set (0: no bond), the pulled block has nothing to hold it
     assert "the run restarted at step 2 failed" in report["restart"].detail
     assert "checkpoint_fields" in report["restart"].fix
+
+
+def test_the_error_norm_on_gamma_c():
+    """||f||_{L2(Gamma_C)} of f = x + 5 y on the block (Gamma_C: y = 0, 0 < x < 1) is
+    sqrt(1/3): the values off Gamma_C do not count."""
+    from mpi4py import MPI
+    import ufl
+    from dolfinx import fem
+    from damage_dolfinx.viz.post import ComponentNorm
+    geometry = demo["block"](MPI.COMM_WORLD, 2)
+    Z = dd.blocks.scalar_p1(geometry.mesh)
+    f, zero = fem.Function(Z), fem.Function(Z)
+    x = ufl.SpatialCoordinate(geometry.mesh)
+    dd.blocks.interpolate(f, dd.blocks.expression(x[0] + 5.0 * x[1], Z))
+    norm = ComponentNorm(f, "L2_GammaC", geometry.facet_tags)
+    assert abs(norm(zero) - np.sqrt(1.0 / 3.0)) < 1e-12
+    assert abs(ComponentNorm(f, "L2")(zero) - np.sqrt(
+        fem.assemble_scalar(fem.form(f * f * ufl.dx)))) < 1e-12
+    with pytest.raises(ValueError, match="facet tags"):
+        ComponentNorm(f, "L2_GammaC")
