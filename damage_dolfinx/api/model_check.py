@@ -205,13 +205,19 @@ def check_model(model, out=None, steps=4, n=None, mpi=True, script=None, name="p
             add("restart", "skipped", "the model has no checkpoints (checkpoint_supported)")
         else:
             resumed = out / "restarted"
+            fix = ("a Function the step reads from the previous step is not checkpointed: put "
+                   "it in old_state (it is then checkpointed) or in checkpoint_fields")
             run(problem, resumed, T=half * k, checkpoint_every=1, **options)
-            run(problem, resumed, T=T, restart=True, **{**options, "overwrite": False})
-            d, where = _differ(final, _fields(resumed))
-            add("restart", "pass" if d <= AGREEMENT else "fail",
-                f"restarted at step {half}: largest relative difference {d:.2e} ({where or '-'})",
-                "a Function the step reads from the previous step is not checkpointed: put it "
-                "in old_state (it is then checkpointed) or in checkpoint_fields")
+            try:  # a state left out of the checkpoint may also make the restarted run fail
+                run(problem, resumed, T=T, restart=True, **{**options, "overwrite": False})
+            except (ConvergenceError, InputError) as exc:
+                add("restart", "fail", f"the run restarted at step {half} failed: "
+                    f"{type(exc).__name__}: {exc}", fix)
+            else:
+                d, where = _differ(final, _fields(resumed))
+                add("restart", "pass" if d <= AGREEMENT else "fail",
+                    f"restarted at step {half}: largest relative difference {d:.2e} "
+                    f"({where or '-'})", fix)
         _parallel(report, case, problem, script, name, mpi, comm, out, n_run, k, T, final)
         return report
     finally:

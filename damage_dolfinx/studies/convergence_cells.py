@@ -268,7 +268,8 @@ class _Transfers:
 
 def _norm_statement(components) -> str:
     """The norm of the errors, in words."""
-    words = {"V": "||eps(.)||_L2 (the V norm)", "L2": "the L2 norm"}
+    words = {"V": "||eps(.)||_L2 (the V norm)", "L2": "the L2 norm",
+             "L2_GammaC": "the L2 norm on Gamma_C"}
     return ", ".join(f"{name}: {words[norm]}" for name, _, norm in components)
 
 
@@ -290,9 +291,11 @@ def _check_states(ref, runs, comm, when):
 
 def _component_norms(ref):
     """{name: ComponentNorm} of the reference stepper's ``error_components``."""
-    return {name: post.ComponentNorm(f, norm) for name, f, norm in ref.error_components}
+    tags = getattr(getattr(getattr(ref, "data", None), "geometry", None), "facet_tags", None)
+    return {name: post.ComponentNorm(f, norm, tags) for name, f, norm in ref.error_components}
 
 
 def _error_definition(components) -> str:
-    label = {"V": "||{0} - {0}_hk||_V", "L2": "||{0} - {0}_hk||_L2"}
+    label = {"V": "||{0} - {0}_hk||_V", "L2": "||{0} - {0}_hk||_L2",
+             "L2_GammaC": "||{0} - {0}_hk||_L2(Gamma_C)"}
     return "max_n (" + " + ".join(label[norm].format(name) for name, _, norm in components) + ")"

@@ -133,21 +133,37 @@ def nested_transfer(V_coarse, V_fine, grid):
         NestedTransfer(V_coarse, V_fine, grid)
 
 
-class ComponentNorm:
-    """||f_ref - f||_V (= ||eps(.)||_L2, displacements) or ||f_ref - f||_L2 of one error
-    component, with f given on the fine mesh: sqrt(e^T G e) with the Gram matrix G of the norm
-    assembled once (the same quadrature as assembling the scalar form each time, whose value
-    it equals to round-off, at a fraction of the cost: one sparse product per call)."""
+#: the norms of an error component (``Model.error_components``): the V norm ||eps(.)||_L2, the
+#: L2 norm, the L2 norm on Gamma_C (facet tag 3) of a field that lives there only
+NORMS = ("V", "L2", "L2_GammaC")
 
-    def __init__(self, f_ref, norm: str):
+
+class ComponentNorm:
+    """||f_ref - f||_V (= ||eps(.)||_L2, displacements), ||f_ref - f||_L2 or, for a field on
+    the contact boundary only (norm ``L2_GammaC``, with the reference mesh's ``facet_tags``),
+    ||f_ref - f||_{L2(Gamma_C)} of one error component, with f given on the fine mesh:
+    sqrt(e^T G e) with the Gram matrix G of the norm assembled once (the same quadrature as
+    assembling the scalar form each time, whose value it equals to round-off, at a fraction of
+    the cost: one sparse product per call)."""
+
+    def __init__(self, f_ref, norm: str, facet_tags=None):
         from dolfinx import fem
-        if norm not in ("V", "L2"):
-            raise ValueError(f"unknown error norm {norm!r} (V or L2)")
+        if norm not in NORMS:
+            raise ValueError(f"unknown error norm {norm!r} ({', '.join(NORMS)})")
+        if norm == "L2_GammaC" and facet_tags is None:
+            raise ValueError("the norm L2_GammaC needs the mesh's facet tags")
         self.f_ref, self.e = f_ref, fem.Function(f_ref.function_space)
         V = f_ref.function_space
         du, w = ufl.TrialFunction(V), ufl.TestFunction(V)
-        a = compat.form(ufl.inner(eps(du), eps(w)) * ufl.dx if norm == "V" else
-                        ufl.inner(du, w) * ufl.dx)
+        if norm == "V":
+            a = ufl.inner(eps(du), eps(w)) * ufl.dx
+        elif norm == "L2":
+            a = ufl.inner(du, w) * ufl.dx
+        else:
+            from damage_dolfinx.core.tags import GAMMA_C
+            a = ufl.inner(du, w) * ufl.ds(domain=V.mesh, subdomain_data=facet_tags,
+                                          subdomain_id=GAMMA_C)
+        a = compat.form(a)
         self.G = compat.create_matrix(a)
         compat.assemble_matrix(self.G, a, [])
         self.G.assemble()
