@@ -198,6 +198,10 @@ SUBJECTS = {
     "stress_central": ("stress",),
 }
 
+#: checks that hold by construction (the solver refuses a damage outside [zeta*, 1]): they
+#: can make a verdict differ, never carry one (reproduction.classes.Evidence.sanity)
+SANITY = ("physical",)
+
 #: a share of the nodes more than 0.09 above zeta* below which the damage has no pattern to
 #: judge (the body is at zeta* nearly everywhere)
 PATTERN_SHARE = 0.1
@@ -356,7 +360,7 @@ def evidence(fig, npzs, related=(), context=None):
         c["thesis_amplification"] = fig.thesis_amplification
     first = next((n for n in npzs if n), None)
     m = measure(first, related) if first else {}
-    checks = []
+    checks, sanity = [], []
     for name in fig.checks:
         desc, pred = CHECKS[name]
         try:
@@ -371,7 +375,7 @@ def evidence(fig, npzs, related=(), context=None):
             elif not holds:
                 ok, number = False, f"{number}; premise fails: {reason}" if number else \
                     f"premise fails: {reason}"
-        checks.append((desc, ok, number))
+        (sanity if name in SANITY else checks).append((desc, ok, number))
     zs = m.get("zeta_star", 0.01)
     if fig.about_damage and "zeta_min" in m and 1 - m["zeta_min"] < NO_DAMAGE:
         checks.append(("damage developed (ζ below 1 - 1e-3 somewhere)", False,
@@ -388,11 +392,11 @@ def evidence(fig, npzs, related=(), context=None):
     got = describe(m, c, fig.checks)
     e = Evidence(kind="result", statement=bool(fig.checks), no_statement=fig.no_statement,
                  quote=fig.quote,
-                 checks=checks, departures=list(c.get("departures") or []),
+                 checks=checks, sanity=sanity, departures=list(c.get("departures") or []),
                  stopped_early=stopped_early(fig, c), invisible=invisible,
                  quick=bool(c.get("quick")))
     if first is None and not c:
-        e.checks = []
+        e.checks, e.sanity = [], []
     return e, got or "-"
 
 
@@ -401,7 +405,7 @@ def judge(fig, npzs, related=(), context=None) -> tuple:
     class (reproduction.classes.CLASSES)."""
     from reproduction.classes import classify
     e, got = evidence(fig, npzs, related, context)
-    return classify(e), got, [c[0] for c in e.checks if c[1] is False]
+    return classify(e), got, [c[0] for c in e.sanity + e.checks if c[1] is False]
 
 
 def describe(m: dict, c: dict, checks=()) -> str:

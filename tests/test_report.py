@@ -522,3 +522,39 @@ def test_figure_3_21_stress_location_is_tested(tmp_path):
         verdict = judge(fig, [npz], context=context)[0]
         assert category(verdict) == expected, verdict
     assert "% of the body's length from its middle" in verdict
+
+
+def test_planted_check_that_holds_by_construction_carries_no_verdict(tmp_path):
+    """The damage within [zeta*, 1] holds by construction (the solver refuses anything else):
+    a figure whose statement (stress and damage coincide) is not measured -- no stress in its
+    data -- is not comparable, not reproduced on that check alone; with one of two checks of
+    its statement unmeasured and none failing, it is not comparable; a failing sanity check
+    still makes it differ; with the stress present the same damage is reproduced."""
+    import numpy as np
+    from damage_dolfinx.viz import figstyle
+    from reproduction.checks import judge
+    from reproduction.classes import Evidence, category, classify
+    from reproduction.figures import ThesisFigure
+    cells = _square()
+    zeta = 0.2 + 0.8 * cells[..., 1]
+    figstyle.save_panels(tmp_path / "z.png", [dict(xy=cells, values=zeta, name="zeta",
+                                                   label="damage zeta")],
+                         title="t", amplification=1.0, zeta_star=0.01, ref_xy=cells)
+    no_stress = tmp_path / f"z{figstyle.PANEL_SUFFIX}"
+    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"),
+                       quote="the highest stress coincides with the highest damage",
+                       subject=("stress", "damage"))
+    verdict = judge(fig, [no_stress])[0]
+    assert category(verdict) == "not comparable", verdict
+    assert "only what holds by construction" in verdict, verdict
+    assert category(judge(fig, [_panel(tmp_path, "with_stress", cells, zeta)])[0]) == \
+        "reproduced"
+    two = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "localised", "colocated"),
+                       quote="the damage is concentrated where the stress is highest",
+                       subject=("stress", "damage"))
+    verdict = judge(two, [no_stress])[0]
+    assert category(verdict) == "not comparable" and "part of the statement is not measured" \
+        in verdict and "rank together" in verdict, verdict
+    bad = classify(Evidence(checks=[("stress and damage rank together", True, "0.9")],
+                            sanity=[("the damage within [ζ*, 1]", False, "ζ in [-0.1, 1]")]))
+    assert category(bad) == "differs", bad
