@@ -558,3 +558,19 @@ def test_planted_check_that_holds_by_construction_carries_no_verdict(tmp_path):
     bad = classify(Evidence(checks=[("stress and damage rank together", True, "0.9")],
                             sanity=[("the damage within [ζ*, 1]", False, "ζ in [-0.1, 1]")]))
     assert category(bad) == "differs", bad
+
+
+def test_setting_mesh_note_is_drawn_under_the_figure(tmp_path):
+    """reproduction.plots.note_under writes the setting figure with its mesh note under it
+    (the image a strip taller, the original kept as drawn), from the run's own copy."""
+    import matplotlib.image
+    import numpy as np
+    from reproduction.plots import note_under
+    source, png = tmp_path / "source.png", tmp_path / "figure_2_1.png"
+    matplotlib.image.imsave(source, np.full((120, 200, 3), 0.5))
+    note_under(png, "drawn on our mesh n = 20; the thesis's Figure 2.1 shows its mesh for n = 10",
+               source)
+    img = matplotlib.image.imread(png)
+    assert img.shape[:2] == (150, 200)
+    assert np.allclose(img[:120, :, :3], 0.5, atol=0.02)      # the figure, unchanged
+    assert img[120:, :, :3].min() < 0.5                       # the note: dark text on white
