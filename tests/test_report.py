@@ -574,3 +574,34 @@ def test_setting_mesh_note_is_drawn_under_the_figure(tmp_path):
     assert img.shape[:2] == (150, 200)
     assert np.allclose(img[:120, :, :3], 0.5, atol=0.02)      # the figure, unchanged
     assert img[120:, :, :3].min() < 0.5                       # the note: dark text on white
+
+
+def test_planted_checks_that_hold_trivially(tmp_path):
+    """No check holds whatever the data: Figure 2.12's drawn-size check fails for a slide the
+    thesis's x3 would not show (a micrometre on a 4 m square: the top-fixed, bottom-moving
+    ratio alone would still hold); Figure 2.21's statement is about the configuration: judged
+    by the displacement left at the final time, a body back at rest differs, a displaced one
+    is reproduced whatever its (vanishing) stress -- no 'stress above zero' check, which any
+    rounding passes."""
+    import numpy as np
+    from reproduction.checks import CHECKS, judge
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES
+    fig = next(f for f in THESIS_FIGURES if f.number == "2.12")
+    cells = 4 * _square()
+    context = {"T_full": 5.0, "status": "completed", "t_final": 5.0, "departures": []}
+    disp = np.zeros_like(cells)
+    disp[..., 0] = 1e-6 * (1 - cells[..., 1] / 4)            # bottom slides a micrometre
+    npz = _panel(tmp_path, "micro", cells, np.ones(cells.shape[:2]), disp=disp,
+                 amplification=3.0)
+    verdict = judge(fig, [npz], context=context)[0]
+    assert category(verdict) == "differs" and "is visible" in verdict, verdict
+    assert "top edge 0.00, bottom edge 1.00" not in verdict.split("ours:")[0]
+    fig_2_21 = next(f for f in THESIS_FIGURES if f.number == "2.21")
+    assert fig_2_21.subject == ("configuration",) and "stressed" not in CHECKS
+    at_rest = _panel(tmp_path, "at_rest", cells, np.ones(cells.shape[:2]),
+                     stress=np.full(cells.shape[:2], 1e-3), disp=0.01 * np.ones_like(cells))
+    for last, expected in ((0.001, "differs"), (0.05, "reproduced")):
+        context = {"u_L2_first": 0.11, "u_L2_last": last, "u_L2_max": 0.17}
+        verdict = judge(fig_2_21, [at_rest], context=context)[0]
+        assert category(verdict) == expected, verdict
