@@ -18,7 +18,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # benchmarks/: com
 import common  # noqa: E402,F401  (puts the checkout on sys.path)
 from reproduction.classes import CLASSES, category, is_quick  # noqa: E402
 
-_ROW = re.compile(r"^\| \[(?P<item>(?:Table|Figure) \d\.\d+)](#[^)]+\) \| (?P<rest>.*) \|$")
+_ROW = re.compile(r"^\| \[(?P<item>(?:Table|Figure) \d\.\d+)\]\(#[^)]+\) \| (?P<rest>.*) \|$")
 
 
 def _cells(rest: str) -> list:
