@@ -8,7 +8,9 @@ The rules, in the order they are applied (the first that applies gives the class
    it that could be tested (a figure that only shows what is plotted, a withheld table; refused
    when the item quotes a thesis statement: that statement is tested); when
    its run stops before the time the thesis's statement is about (an early stop is never
-   evidence); or when nothing the statement names could be measured.
+   evidence); or when nothing the statement names could be measured. A check that holds by
+   construction (``Evidence.sanity``: the damage plotted within [ζ*, 1], which the solver
+   enforces) is no measurement of the statement: it can make a verdict differ, never carry one.
 2. **drawn as stated**: a setting figure that draws the geometry and boundary layout the thesis
    states. It is a drawing, not a result.
 3. **setting assumed**: a setting figure whose geometry or layout the thesis does not give (or
@@ -19,6 +21,8 @@ The rules, in the order they are applied (the first that applies gives the class
    damage is away from ζ* where its pattern is judged); where the premise fails, the check
    fails with that reason. Each statement is tagged with its subject (damage, stress,
    configuration, contact, a number) and is judged only by the checks of that subject.
+   Where no check fails but a check of the statement could not be measured, the item is
+   **not comparable** (the part measured is not the statement).
 5. **not visible in this figure**: every check holds (the data carry the statement), but the
    figure cannot show it: the damage field spans less than ``ONE_COLOUR`` of the fixed colour
    scale [ζ*, 1], or two fields that should differ are the same colours (statements about the
@@ -58,8 +62,10 @@ RULES = {
                "is judged, damage at ζ* nearly everywhere where a pattern is judged); the "
                "number is quoted",
     "not comparable": "nothing to test: not produced, no statement of its own in the thesis, a "
-                      "withheld table, nothing measured, or a run that stops before the "
-                      "thesis's time (never evidence)",
+                      "withheld table, nothing measured (a check that holds by construction, "
+                      "such as the damage within [ζ*, 1], measures nothing), part of the "
+                      "statement not measured and nothing failed, or a run that stops before "
+                      "the thesis's time (never evidence)",
 }
 
 #: a damage field spanning less than this fraction of the fixed scale [zeta*, 1] is one colour
@@ -79,6 +85,8 @@ class Evidence:
     """What an item's data show, for :func:`classify`.
 
     ``checks``: (what is tested, holds: True/False/None if not measured, our number as text).
+    ``sanity``: checks of the same form that hold by construction (the damage plotted within
+    [ζ*, 1]): a failed one makes the verdict differ, but they never carry a verdict.
     ``departures``: the departure records of the data (summary.json's ``reading``).
     """
     kind: str = "result"                 # result | table | setting
@@ -87,6 +95,7 @@ class Evidence:
     no_statement: str = ""               # why not (for the verdict)
     quote: str = ""                      # the thesis sentence the row quotes ('' if none)
     checks: list = field(default_factory=list)
+    sanity: list = field(default_factory=list)
     departures: list = field(default_factory=list)
     stopped_early: str = ""              # the run stops before the thesis's time: how
     invisible: str = ""                  # why the figure cannot show what the data carry
@@ -126,14 +135,21 @@ def _classify(e: Evidence) -> str:
         return f"not comparable: {e.stopped_early}; a run that stops early is no evidence"
     measured = [c for c in e.checks if c[1] is not None]
     if not measured:
-        return "not comparable: nothing the thesis's statement names is measured"
+        return "not comparable: nothing the thesis's statement names is measured" + (
+            " (only what holds by construction: " + "; ".join(c[0] for c in e.sanity) + ")"
+            if e.sanity else "")
+    sanity = [c for c in e.sanity if c[1] is not None]
     tail = f"; departures: {departures_text(e.departures)}" if e.departures else ""
-    failed = [c for c in measured if not c[1]]
+    failed = [c for c in sanity + measured if not c[1]]
     if failed:
         return "differs: " + "; ".join(f"the thesis says: {c[0]}; ours: {c[2]}" if c[2] else
                                        f"the thesis says: {c[0]}; ours: it does not hold"
                                        for c in failed) + tail
-    held = "; ".join(f"{c[0]} ({c[2]})" if c[2] else c[0] for c in measured)
+    held = "; ".join(f"{c[0]} ({c[2]})" if c[2] else c[0] for c in sanity + measured)
+    unmeasured = [c[0] for c in e.checks if c[1] is None]
+    if unmeasured:
+        return (f"not comparable: part of the statement is not measured ({'; '.join(unmeasured)})"
+                f"; what is measured holds: {held}{tail}")
     if e.invisible:
         return f"not visible in this figure: {e.invisible}; the data show: {held}{tail}"
     if e.departures:

@@ -50,7 +50,7 @@ def note_under(png: Path, text: str, source: Path = None) -> Path:
     (what a setting figure draws that its thesis caption does not: reproduction.figures.
     mesh_drawn)."""
     from damage_dolfinx.viz import figstyle
-    plt = figstyle.plt()
+    plt = figstyle.pyplot_styled()  # an application script's pyplot: imread, figure, close
     img = plt.imread(source or png)
     h, w = img.shape[:2]
     dpi, strip = 100, 30

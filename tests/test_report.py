@@ -522,3 +522,86 @@ def test_figure_3_21_stress_location_is_tested(tmp_path):
         verdict = judge(fig, [npz], context=context)[0]
         assert category(verdict) == expected, verdict
     assert "% of the body's length from its middle" in verdict
+
+
+def test_planted_check_that_holds_by_construction_carries_no_verdict(tmp_path):
+    """The damage within [zeta*, 1] holds by construction (the solver refuses anything else):
+    a figure whose statement (stress and damage coincide) is not measured -- no stress in its
+    data -- is not comparable, not reproduced on that check alone; with one of two checks of
+    its statement unmeasured and none failing, it is not comparable; a failing sanity check
+    still makes it differ; with the stress present the same damage is reproduced."""
+    import numpy as np
+    from damage_dolfinx.viz import figstyle
+    from reproduction.checks import judge
+    from reproduction.classes import Evidence, category, classify
+    from reproduction.figures import ThesisFigure
+    cells = _square()
+    zeta = 0.2 + 0.8 * cells[..., 1]
+    figstyle.save_panels(tmp_path / "z.png", [dict(xy=cells, values=zeta, name="zeta",
+                                                   label="damage zeta")],
+                         title="t", amplification=1.0, zeta_star=0.01, ref_xy=cells)
+    no_stress = tmp_path / f"z{figstyle.PANEL_SUFFIX}"
+    fig = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "colocated"),
+                       quote="the highest stress coincides with the highest damage",
+                       subject=("stress", "damage"))
+    verdict = judge(fig, [no_stress])[0]
+    assert category(verdict) == "not comparable", verdict
+    assert "only what holds by construction" in verdict, verdict
+    assert category(judge(fig, [_panel(tmp_path, "with_stress", cells, zeta)])[0]) == \
+        "reproduced"
+    two = ThesisFigure("9.9", "x", "", ("a.png",), ("physical", "localised", "colocated"),
+                       quote="the damage is concentrated where the stress is highest",
+                       subject=("stress", "damage"))
+    verdict = judge(two, [no_stress])[0]
+    assert category(verdict) == "not comparable" and "part of the statement is not measured" \
+        in verdict and "rank together" in verdict, verdict
+    bad = classify(Evidence(checks=[("stress and damage rank together", True, "0.9")],
+                            sanity=[("the damage within [ζ*, 1]", False, "ζ in [-0.1, 1]")]))
+    assert category(bad) == "differs", bad
+
+
+def test_setting_mesh_note_is_drawn_under_the_figure(tmp_path):
+    """reproduction.plots.note_under writes the setting figure with its mesh note under it
+    (the image a strip taller, the original kept as drawn), from the run's own copy."""
+    import matplotlib.image
+    import numpy as np
+    from reproduction.plots import note_under
+    source, png = tmp_path / "source.png", tmp_path / "figure_2_1.png"
+    matplotlib.image.imsave(source, np.full((120, 200, 3), 0.5))
+    note_under(png, "drawn on our mesh n = 20; the thesis's Figure 2.1 shows its mesh for n = 10",
+               source)
+    img = matplotlib.image.imread(png)
+    assert img.shape[:2] == (150, 200)
+    assert np.allclose(img[:120, :, :3], 0.5, atol=0.02)      # the figure, unchanged
+    assert img[120:, :, :3].min() < 0.5                       # the note: dark text on white
+
+
+def test_planted_checks_that_hold_trivially(tmp_path):
+    """No check holds whatever the data: Figure 2.12's drawn-size check fails for a slide the
+    thesis's x3 would not show (a micrometre on a 4 m square: the top-fixed, bottom-moving
+    ratio alone would still hold); Figure 2.21's statement is about the configuration: judged
+    by the displacement left at the final time, a body back at rest differs, a displaced one
+    is reproduced whatever its (vanishing) stress -- no 'stress above zero' check, which any
+    rounding passes."""
+    import numpy as np
+    from reproduction.checks import CHECKS, judge
+    from reproduction.classes import category
+    from reproduction.figures import THESIS_FIGURES
+    fig = next(f for f in THESIS_FIGURES if f.number == "2.12")
+    cells = 4 * _square()
+    context = {"T_full": 5.0, "status": "completed", "t_final": 5.0, "departures": []}
+    disp = np.zeros_like(cells)
+    disp[..., 0] = 1e-6 * (1 - cells[..., 1] / 4)            # bottom slides a micrometre
+    npz = _panel(tmp_path, "micro", cells, np.ones(cells.shape[:2]), disp=disp,
+                 amplification=3.0)
+    verdict = judge(fig, [npz], context=context)[0]
+    assert category(verdict) == "differs" and "is visible" in verdict, verdict
+    assert "top edge 0.00, bottom edge 1.00" not in verdict.split("ours:")[0]
+    fig_2_21 = next(f for f in THESIS_FIGURES if f.number == "2.21")
+    assert fig_2_21.subject == ("configuration",) and "stressed" not in CHECKS
+    at_rest = _panel(tmp_path, "at_rest", cells, np.ones(cells.shape[:2]),
+                     stress=np.full(cells.shape[:2], 1e-3), disp=0.01 * np.ones_like(cells))
+    for last, expected in ((0.001, "differs"), (0.05, "reproduced")):
+        context = {"u_L2_first": 0.11, "u_L2_last": last, "u_L2_max": 0.17}
+        verdict = judge(fig_2_21, [at_rest], context=context)[0]
+        assert category(verdict) == expected, verdict
