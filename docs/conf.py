@@ -1,6 +1,6 @@
 """Sphinx configuration of the damage-dolfinx documentation (``make docs``).
 
-Three pages are generated here at every build, from the code itself, into ``_generated/``
+The pages below are generated here at every build, from the code itself, into ``_generated/``
 (not kept in git) and included by their page:
 
 - ``cli.md``: ``damage-dolfinx --help`` and the help of every subcommand, from the argparse
@@ -8,6 +8,9 @@ Three pages are generated here at every build, from the code itself, into ``_gen
 - ``api.md``: one autodoc entry per name in ``damage_dolfinx.__all__`` (functions, classes,
   modules, data), so a name added to ``__all__`` is documented without touching the docs;
 - ``records.md``: ``benchmarks/README.md`` with its headings one level down;
+- ``catalogue.md``: every example of the catalogue, from the catalogue itself: its model, mesh,
+  default n or h, k, T, the thesis figures and study it reproduces, the text of
+  ``damage-dolfinx show ID``;
 - ``report.md``: a link to the thesis reproduction report when ``make report`` has written it
   (``$DAMAGE_DOLFINX_RESULTS/REPORT.html``, default ``results/``); the report and the files it
   refers to are copied into the site.
@@ -174,6 +177,64 @@ def _api_page():
     return "\n".join(lines)
 
 
+# --- the catalogue of examples ------------------------------------------------------------
+def _thesis_figure(filename):
+    """'figure_2_12_left.png' -> 'Fig. 2.12 (left)', 'figure_2_24_25.png' -> 'Figs 2.24-2.25';
+    a figure of the package's own (fields_final.png, ...) -> None."""
+    m = re.fullmatch(r"figure_(\d)_(\d+)(?:_(\d+))?(?:_(left|right))?\.png", filename)
+    if not m:
+        return None
+    chapter, first, second, side = m.groups()
+    text = (f"Figs {chapter}.{first}-{chapter}.{second}" if second
+            else f"Fig. {chapter}.{first}")
+    return text + (f" ({side})" if side else "")
+
+
+def _cell(text):
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _catalogue_page():
+    """Every example of the catalogue (``damage-dolfinx list``), from the catalogue itself: a
+    table of its data, then each example with what it reproduces and the text of
+    ``damage-dolfinx show ID``."""
+    from damage_dolfinx.catalogue.examples import catalogue
+    from damage_dolfinx.cli.show import show
+    from damage_dolfinx.models.registry import model
+    examples = list(catalogue().values())
+    lines = ["| id | thesis | model | mesh | default n / h | k | T | reproduces |",
+             "|---|---|---|---|---|---|---|---|"]
+    details = []
+    for ex in examples:
+        info = model(ex.model_id)
+        where = f"§{ex.section}" if ex.dim == 2 else f"beyond the thesis (§{ex.section} in 3-D)"
+        mesh = (f"gmsh, {ex.dim}-D" if ex.h is not None else f"structured family, {ex.dim}-D")
+        size = f"h = {ex.h:g}" if ex.h is not None else f"n = {ex.n}"
+        figures = [f for f in ex.figures if _thesis_figure(f.filename)]
+        what = [_thesis_figure(f.filename) for f in figures]
+        if ex.convergence:
+            what.append("convergence study")
+        if not what:
+            what = ["the package's own figures"]
+        anchor = "ex-" + re.sub(r"[^a-z0-9]+", "-", ex.id.lower())
+        lines.append(f"| {{ref}}`{ex.id} <{anchor}>` | {where} | {ex.model_id}: {_cell(info.title)} | "
+                     f"{mesh} | {size} | {ex.k:.4g} | {ex.T:g} | {', '.join(what)} |")
+        details += [f"({anchor})=", f"### `{ex.id}`: {_cell(ex.title)}", ""]
+        for f in ex.figures:
+            number = _thesis_figure(f.filename)
+            details.append(f"- `{f.filename}`: {_cell(f.title)}"
+                           + (f" (thesis {number})" if number else ""))
+        if ex.convergence:
+            c = ex.convergence
+            details.append(f"- `damage-dolfinx converge {ex.id}`: the thesis convergence study, "
+                           f"reference n = {c.get('ref_n')}, k = {c.get('ref_k'):g}; levels "
+                           f"n = {', '.join(map(str, c.get('n', [])))}, "
+                           f"k = {', '.join(f'{k:g}' for k in c.get('k', []))}")
+        details += ["", "```text", f"$ damage-dolfinx show {ex.id}", show(ex.id, {}).rstrip(),
+                    "```", ""]
+    return "\n".join(lines + ["", "## Every example", ""] + details)
+
+
 # --- the thesis reproduction report --------------------------------------------------------
 def _report_page(app):
     results = Path(os.environ.get("DAMAGE_DOLFINX_RESULTS", ROOT / "results"))
@@ -215,6 +276,7 @@ def _generate(app):
     _write_if_changed(GENERATED / "api.md", _api_page())
     _write_if_changed(GENERATED / "report.md", _report_page(app))
     _write_if_changed(GENERATED / "records.md", _records_page())
+    _write_if_changed(GENERATED / "catalogue.md", _catalogue_page())
 
 
 def _attribute_comment(name, obj):

@@ -128,3 +128,46 @@ def test_petsc_options_of_the_api(tmp_path):
     assert got == {"mech_ksp_type": "cg", "damage_snes_monitor": "", "log_view": "out.txt"}
     with pytest.raises(dd.InputError, match="unknown option -mehc_ksp_type"):
         dd.petsc_options_from_argv(["-mehc_ksp_type", "cg"])
+
+
+def test_petsc_options_set_by_hand_are_checked(tmp_path):
+    """Options a script puts into PETSc.Options() itself meet the command line's checks when a
+    call starts: a misspelt prefix and a bad value are refused with one line before any work
+    (no folder), an unread option is warned about; a prefix that is nobody's near-miss (the
+    script's own solver) and the package's own defaults are left alone."""
+    import damage_dolfinx as dd
+    from petsc4py import PETSc
+    kw = dict(n=5, T=0.05, progress=False, figures=False)
+    opts = PETSc.Options()
+    refused = {"mehc_ksp_type": ("cg", "unknown PETSc option -mehc_ksp_type in the options "
+                                       "database.*did you mean -mech_ksp_type\\?"),
+               "dmage_snes_monitor": ("", "did you mean -damage_snes_monitor"),
+               "mech_ksp_type": ("nonsense", "PETSc refuses the options -mech_ksp_type "
+                                             "nonsense \\(set in the PETSc options database\\)")}
+    for name, (value, message) in refused.items():
+        opts[name] = value
+        try:
+            with pytest.raises(dd.InputError, match=message) as caught:
+                dd.run("2.1-ex1", tmp_path / "a", **kw)
+            assert "\n" not in str(caught.value)
+            with pytest.raises(dd.InputError, match=message):
+                dd.sweep("2.1-ex1", tmp_path / "a", {"kappa": [1.0, 2.0]}, n=5, T=0.05,
+                         progress=False)
+        finally:
+            opts.delValue(name)
+        assert not (tmp_path / "a").exists()  # refused before any work
+    opts["mech_snes_nonsense_flag"] = "1"  # under a package prefix: read by no solver
+    opts["p_ksp_type"] = "cg"              # the script's own solver: not a near-miss
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            assert dd.run("2.1-ex1", tmp_path / "b", **kw)["status"] == "completed"
+            assert dd.run("2.1-ex1", tmp_path / "c", **kw)["status"] == "completed"
+        messages = [str(w.message) for w in caught if "PETSc option" in str(w.message)]
+        assert messages == ["no solver of this run read the PETSc option(s) "
+                            "-mech_snes_nonsense_flag (set in the PETSc options database "
+                            "before the call): they had no effect"] * 2  # defaults not named
+        assert opts.getString("mech_snes_nonsense_flag") == "1"  # the user's: kept
+    finally:
+        opts.delValue("mech_snes_nonsense_flag")
+        opts.delValue("p_ksp_type")

@@ -138,7 +138,7 @@ def test_traction_arrows_push_onto_and_pull_away_from_the_body():
 
 def test_convergence_error_label_in_mathtext():
     assert figstyle.error_mathtext("max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)") == \
-        r"$\max_n\, (\|u - u^{hk}\|_{V} + \|\zeta - \zeta^{hk}\|_{L^2})$"
+        r"$\max_n\, (\Vert u - u^{hk}\Vert_{V} + \Vert \zeta - \zeta^{hk}\Vert_{L^2})$"
     assert figstyle.mathtext("Gamma_D (clamped)") == r"$\Gamma_D$ (clamped)"
 
 

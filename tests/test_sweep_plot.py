@@ -1,6 +1,9 @@
 """The final scalars known before any work (validation_scalars.py) are those a run reports, for
 every model of the package: the sweep refuses a plot of any other name before it writes
-anything, and the two lists can never drift apart."""
+anything, and the two lists can never drift apart. The study plots (sweep.png,
+convergence.png) say what they show: axes named by their quantities, log axes where slopes are
+read, the measured slope of every line, a reference slope, a legend off the data, no text over
+other text, and the user's matplotlib session untouched."""
 import json
 import subprocess
 import sys
@@ -86,3 +89,109 @@ def test_sweep_refuses_an_unknown_plot_before_any_work(tmp_path):
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.strip().count("\n") == 0 and "reports: u_L2" in proc.stderr
     assert proc.stdout == "" and not out.exists()
+
+
+def _drawn(monkeypatch, name):
+    """Capture the figure a study plot hands to ``figstyle.<name>`` (drawn, before it is
+    saved and closed): its axes, legend texts, all visible text boxes."""
+    import matplotlib.text
+    from damage_dolfinx.viz import figstyle
+    seen = {}
+    original = getattr(figstyle, name)
+
+    def capture(fig, path, *args, **kwargs):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        ax = fig.axes[0]
+        legend = ax.get_legend()
+        hidden = set()  # labels of ticks outside the view: kept by matplotlib, not drawn
+        for axis in (ax.xaxis, ax.yaxis):
+            lo, hi = sorted(axis.get_view_interval())
+            for tick in axis.get_major_ticks() + axis.get_minor_ticks():
+                if not lo * (1 - 1e-9) <= tick.get_loc() <= hi * (1 + 1e-9):
+                    hidden.update({id(tick.label1), id(tick.label2)})
+        texts = [t for t in fig.findobj(matplotlib.text.Text)
+                 if t.get_visible() and t.get_text().strip() and id(t) not in hidden]
+        seen.update(ax=dict(xscale=ax.get_xscale(), yscale=ax.get_yscale(),
+                            xlabel=ax.get_xlabel(), ylabel=ax.get_ylabel(),
+                            title=ax.get_title() or (fig._suptitle.get_text()
+                                                     if fig._suptitle else "")),
+                    legend=[t.get_text() for t in legend.get_texts()] if legend else [],
+                    legend_box=legend.get_window_extent(renderer) if legend else None,
+                    axes_box=ax.get_window_extent(renderer),
+                    boxes=[(t.get_text(), t.get_window_extent(renderer)) for t in texts],
+                    sizes=[t.get_fontsize() for t in texts])
+        return original(fig, path, *args, **kwargs)
+    monkeypatch.setattr(figstyle, name, capture)
+    return seen
+
+
+def _no_text_over_text(boxes):
+    """No two visible texts of the figure overlap (a pixel of contact allowed)."""
+    clash = []
+    for i, (a, ba) in enumerate(boxes):
+        for b, bb in boxes[i + 1:]:
+            if (min(ba.x1, bb.x1) - max(ba.x0, bb.x0) > 1
+                    and min(ba.y1, bb.y1) - max(ba.y0, bb.y0) > 1):
+                clash.append((a, b))
+    return clash
+
+
+def _session():
+    import matplotlib
+    return matplotlib.get_backend(), dict(matplotlib.rcParams)
+
+
+def test_convergence_plot_reads_as_a_convergence_plot(tmp_path, monkeypatch):
+    """Errors of a known order (0.8 in h + k on every line): the legend prints slope 0.80 for
+    every time step and the fit, a reference slope is drawn, both axes are logarithmic and
+    named, the legend lies under the axes, no text covers another and the session's backend
+    and rcParams are unchanged."""
+    import math
+    from damage_dolfinx.studies import convergence_tables as tables
+    rows = [dict(n=n, h=5 * math.sqrt(2) / n, k=k, h_plus_k=5 * math.sqrt(2) / n + k,
+                 error=0.03 * (5 * math.sqrt(2) / n + k) ** 0.8)
+            for n in (5, 10, 20) for k in (0.1, 0.05, 0.025)]
+    rates = tables.fitted_rates(rows, [5, 10, 20], [0.1, 0.05, 0.025])
+    seen = _drawn(monkeypatch, "save_as_laid_out")
+    before = _session()
+    tables.plot_convergence(tmp_path / "convergence.png", rows, rates, "2.1-ex1", 40, 0.0125,
+                            "max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)",
+                            title="2.1-ex1: a title long enough to be wrapped over two lines "
+                                  "of the column")
+    assert _session() == before
+    assert (tmp_path / "convergence.png").stat().st_size > 1000
+    assert seen["ax"]["xscale"] == seen["ax"]["yscale"] == "log"
+    assert "$h + k$" in seen["ax"]["xlabel"] and "\\Vert" in seen["ax"]["ylabel"]
+    assert seen["legend"] == [f"$k$ = {k:g}: slope 0.80" for k in (0.1, 0.05, 0.025)] + [
+        "fit, all cells: slope 0.80", "reference slope 1"]
+    assert "reference $n$ = 40, $k$ = 0.0125" in seen["ax"]["title"]
+    assert seen["legend_box"].y1 <= seen["axes_box"].y0  # under the axes, off the data
+    assert not _no_text_over_text(seen["boxes"]), _no_text_over_text(seen["boxes"])
+    assert min(seen["sizes"]) >= 6.5  # legible in a journal column at 300 dpi
+    assert [t for t, _ in seen["boxes"]].count("1") == 2  # the triangle's legs, labelled
+
+
+def test_sweep_plot_names_its_quantities(tmp_path, monkeypatch):
+    """sweep.png: the swept parameter and the scalar named by what they are (symbol and
+    --set name), a log axis over a decade, a tick at every swept value, one line per value of
+    the other parameter named in a legend under the axes, no text over text, the session
+    untouched."""
+    from damage_dolfinx.studies.sweep_folder import plot_sweep
+    grid = {"kappa": [0.01, 0.1, 1.0], "lam_u_plus": [500.0, 1000.0]}
+    rows = [dict(kappa=a, lam_u_plus=b, zeta_min=1 - b * 1e-7 / (1 + a))
+            for a in grid["kappa"] for b in grid["lam_u_plus"]]
+    seen = _drawn(monkeypatch, "save")
+    before = _session()
+    plot_sweep(tmp_path / "sweep.png", rows, grid, "zeta_min", "2.1-ex1")
+    assert _session() == before
+    ax = seen["ax"]
+    assert ax["xscale"] == "log" and ax["yscale"] == "linear"
+    assert ax["xlabel"] == "damage diffusion $\\kappa$ (kappa)"
+    assert "min $\\zeta$" in ax["ylabel"] and "zeta_min" in ax["ylabel"]
+    assert seen["legend"] == ["$\\lambda_u^+$ = 500", "$\\lambda_u^+$ = 1000"]
+    assert seen["legend_box"].y1 <= seen["axes_box"].y0
+    labels = [t for t, _ in seen["boxes"]]
+    assert {"0.01", "0.1", "1"} <= set(labels)
+    assert not _no_text_over_text(seen["boxes"]), _no_text_over_text(seen["boxes"])
+    assert (tmp_path / "sweep.png").stat().st_size > 1000

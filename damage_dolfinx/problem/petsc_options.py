@@ -4,7 +4,10 @@ checked alike, each check in one place: a name outside the package's solver pref
 (PETSC_PREFIXES, :func:`_check_name`) is refused (the command line suggests the double-dash
 option it resembles), a value PETSc refuses is refused before any work
 (:func:`_check_petsc_values`), and an option no solver read is named in a warning at the end
-(:func:`_unused`). The API's options hold for the one call only (:func:`scoped`)."""
+(:func:`_unused`). The API's options hold for the one call only (:func:`scoped`). Options a
+script put into ``PETSc.Options()`` by hand meet the same checks when a call starts
+(:func:`_database_options`): a prefix that misspells one of the package's is refused, the
+values under the package's prefixes are checked, and those no solver read are warned about."""
 from __future__ import annotations
 
 import argparse
@@ -43,6 +46,7 @@ def _petsc_options(tokens, parser, command):
     opts = PETSc.Options()
     for name, value in given.items():
         opts[name] = value
+    _COMMAND_LINE.update(given)
     return given
 
 
@@ -87,10 +91,12 @@ class scoped:
 
     def __init__(self, options, comm, what="run"):
         self.given = normalised(options)
-        self.comm, self.what, self._before = comm, what, {}
+        self.comm, self.what, self._before, self.by_hand = comm, what, {}, {}
 
     def __enter__(self):
-        if not self.given:
+        # options a script put into PETSc.Options() by hand, checked as the given ones are
+        self.by_hand = _agreed_database_options(set(self.given), self.comm)
+        if not self.given and not self.by_hand:
             return self
         from petsc4py import PETSc
         opts = PETSc.Options()
@@ -98,23 +104,28 @@ class scoped:
         for name, value in self.given.items():
             opts[name] = value
         try:
-            _check_petsc_values(self.given)
+            _check_petsc_values({**self.by_hand, **self.given}, set(self.by_hand))
         except BaseException:
             self._restore()
             raise
+        _MANAGED.append(set(self.given) | set(self.by_hand))
         return self
 
     def __exit__(self, exc_type, exc, tb):
-        if not self.given:
+        if not self.given and not self.by_hand:
             return False
+        _MANAGED.pop()
         try:
             if exc_type is None:
                 unused = _unused(self.given, self.comm)
-                if unused and self.comm.rank == 0:
+                by_hand = _unused(self.by_hand, self.comm)
+                if (unused or by_hand) and self.comm.rank == 0:
                     import warnings
+                    where = (" (set in the PETSc options database before the call)"
+                             if by_hand else "")
                     warnings.warn(f"no solver of this {self.what} read the PETSc option(s) "
-                                  f"{' '.join(unused)}: they had no effect", UserWarning,
-                                  stacklevel=3)
+                                  f"{' '.join(unused + by_hand)}{where}: they had no effect",
+                                  UserWarning, stacklevel=3)
         finally:
             self._restore()
         return False
@@ -146,11 +157,12 @@ def _subparser(parser, command):
     return None
 
 
-def _check_petsc_values(given):
+def _check_petsc_values(given, by_hand=()):
     """Every PETSc option given is applied to a throwaway SNES (with its KSP and PC) of its
     prefix, so that a value PETSc refuses (-mech_ksp_type nonsense) is refused now, before any
     work, with one line; the options are then set anew, so that whether a solver of the run
-    reads them (``_unused``) is not confused by this check."""
+    reads them (``_unused``) is not confused by this check. ``by_hand``: the names found in
+    the options database (:func:`_database_options`), so named in the refusal."""
     from petsc4py import PETSc
     from damage_dolfinx.core.parameters import InputError
     prefixes = set()
@@ -169,13 +181,96 @@ def _check_petsc_values(given):
                           f"error code {exc.ierr}")
             options = " ".join(f"-{n} {v}".strip() for n, v in given.items()
                                if n.startswith(prefix))
-            raise InputError(f"PETSc refuses the options {options}: {reason}") from None
+            where = (" (set in the PETSc options database)"
+                     if any(n.startswith(prefix) for n in by_hand) else "")
+            raise InputError(f"PETSc refuses the options {options}{where}: {reason}") from None
         finally:
             snes.destroy()
     opts = PETSc.Options()
     for name, value in given.items():
         opts.delValue(name)
         opts[name] = value
+
+
+#: the option names an active call or the command line put into the database itself (checked
+#: there): a call inside another (a sweep's points, a command's run) does not take them for
+#: options set by hand
+_MANAGED = []
+_COMMAND_LINE = set()
+
+
+def _near_prefix(name):
+    """The name ``name`` meant, when its prefix (the part before its ``ksp_``, ``snes_`` or
+    ``pc_``) misspells one of the package's (``mehc_ksp_type`` -> ``mech_ksp_type``), or None: one of four characters or
+    more, close to a prefix (difflib ratio >= 0.75, letters' case ignored), or a prefix with two
+    letters swapped."""
+    import difflib
+    cut = [name.find(part) for part in _OBJECT_PARTS if name.find(part) > 0]
+    if not cut:
+        return None
+    head, rest = name[:min(cut)].lower(), name[min(cut):]
+    if head in PETSC_PREFIXES:
+        return None
+    for prefix in PETSC_PREFIXES:
+        if sorted(head) == sorted(prefix) and sum(a != b for a, b in zip(head, prefix)) == 2:
+            return prefix + rest
+    close = difflib.get_close_matches(head, PETSC_PREFIXES, n=1, cutoff=0.75)
+    return close[0] + rest if close and len(head) >= 4 else None
+
+
+def _database_options(skip=()):
+    """The options a script put into ``PETSc.Options()`` by hand before a call (or PETSc read
+    at its start), checked as the command line checks its own: a name whose prefix misspells
+    one of the package's (``mehc_ksp_type``) is refused (InputError, one line, before any
+    work); returns {name: value} of those under the package's prefixes (their values are then
+    checked, and those no solver read warned about), leaving out ``skip``, the options the
+    package put there itself (its solvers' defaults) and those of an enclosing call or of the
+    command line. Options of other prefixes (a script's own solvers) are left alone."""
+    if "petsc4py.PETSc" not in sys.modules:
+        return {}
+    from petsc4py import PETSc
+    from damage_dolfinx.core.errors import InputError
+    managed = set(skip) | _COMMAND_LINE
+    for names in _MANAGED:
+        managed |= names
+    solvers = sys.modules.get("damage_dolfinx.numerics.solvers")
+    opts = PETSc.Options()
+    found = {}
+    for name, value in sorted(opts.getAll().items()):
+        if name in managed:
+            continue
+        if solvers is not None and solvers._ours(opts, name):
+            continue  # a default of the package's solvers
+        near = _near_prefix(name)
+        if near is not None:
+            raise InputError(f"unknown PETSc option -{name} in the options database: not an "
+                             f"option of this program's solvers (prefixes "
+                             f"{', '.join(PETSC_PREFIXES)}); did you mean -{near}?")
+        if name.startswith(PETSC_PREFIXES):
+            found[name] = "" if value is True else str(value)
+    return found
+
+
+def _agreed_database_options(skip, comm):
+    """:func:`_database_options` on every rank of ``comm``, one outcome for all: a refusal on
+    any rank is raised on every rank, and so are options set by hand that differ between
+    ranks (the check of which were read compares them rank by rank)."""
+    from damage_dolfinx.core.errors import InputError
+    try:
+        found, error = _database_options(skip), None
+    except InputError as exc:
+        found, error = {}, str(exc)
+    if comm.size > 1:
+        gathered = comm.allgather((error, sorted(found.items())))
+        error = next((e for e, _ in gathered if e), None)
+        if error is None and any(items != gathered[0][1] for _, items in gathered):
+            error = ("the PETSc options set by hand under the package's prefixes differ "
+                     "between the ranks: " + "; ".join(
+                         f"rank {r}: " + (" ".join(f"-{n} {v}".strip() for n, v in items)
+                                          or "none") for r, (_, items) in enumerate(gathered)))
+    if error:
+        raise InputError(error)
+    return found
 
 
 def _unused(given, comm):
@@ -201,6 +296,7 @@ def _forget(given):
     opts = PETSc.Options()
     for name in given:
         opts.delValue(name)
+    _COMMAND_LINE.difference_update(given)
     if "dolfinx" in sys.modules:  # a solver may have run
         from damage_dolfinx.numerics import solvers
         for name in list(solvers._CODE_DEFAULTS):

@@ -55,73 +55,136 @@ def write_tables(out, rows, ns, ks, rates, rates_T, example_id, ref_n, ref_k, de
     (out / "errors.md").write_text("\n".join(lines))
 
 
-#: a journal column (88 mm) and the height of the plot
+#: a journal column (88 mm) and the height of the plot's axes region
 COLUMN_WIDTH_IN, PLOT_HEIGHT_IN = 3.46, 2.9
+#: the order of the reference triangle: the schemes' error estimates are linear in h + k
+REFERENCE_SLOPE = 1.0
+
+
+def line_rates(rows) -> dict:
+    """{k: slope of log error against log(h + k) along the line of that time step} (the slope
+    a reader measures on the plot; NaN for a line of one point)."""
+    out = {}
+    for k in sorted({r["k"] for r in rows}, reverse=True):
+        sel = [r for r in rows if r["k"] == k]
+        out[k] = post.loglog_rate([r["h_plus_k"] for r in sel], [r["error"] for r in sel])
+    return out
+
+
+def _slope_text(p) -> str:
+    return f"slope {p:.2f}" if np.isfinite(p) else "one level: no slope"
+
+
+def _level_labels(levels, ax, fontsize):
+    """A label at every level of h + k that leaves room for the previous one (labels written
+    horizontally, their width estimated from the font size and the axes' width)."""
+    width_in = ax.get_position().width * ax.figure.get_figwidth()
+    lo, hi = np.log10(levels.min()), np.log10(levels.max())
+    per_decade = width_in / max(hi - lo, 1e-12)  # inches per decade of the axis
+    labels, last = [], None
+    for v in levels:
+        text = f"{v:.3g}"
+        need = (0.62 * fontsize / 72) * (len(text) + 1.5)  # inches for this label and a gap
+        show = last is None or np.log10(v / last) * per_decade > need
+        labels.append(text if show else "")
+        last = v if show else last
+    return labels
+
+
+def _reference_triangle(ax, hk, lines, slope):
+    """A slope triangle of order ``slope`` in the lower right of the axes, under every line
+    (``lines``: (x, y) arrays of what is drawn), with its order written beside its vertical
+    leg; returns the lowest error it needs visible."""
+    lx = np.log10(hk.max() / hk.min())
+    x1 = hk.max() / 10 ** (0.06 * lx)
+    x0 = x1 / 10 ** (0.3 * lx)
+    below = []
+    for x, y in lines:
+        order = np.argsort(x)
+        lxs, lys = np.log10(np.asarray(x)[order]), np.log10(np.asarray(y)[order])
+        for xv in np.linspace(np.log10(x0), np.log10(x1), 9):
+            if lxs[0] <= xv <= lxs[-1]:
+                below.append(np.interp(xv, lxs, lys))
+        inside = (lxs >= np.log10(x0)) & (lxs <= np.log10(x1))
+        below += list(lys[inside])
+    top = 10 ** min(below) * 0.72 if below else None
+    if top is None:
+        return None
+    bottom = top / (x1 / x0) ** slope
+    ax.fill([x0, x1, x1], [bottom, bottom, top], facecolor="0.9", edgecolor="0.3", lw=0.8,
+            zorder=1)
+    ax.text(x1 * 10 ** (0.015 * lx), np.sqrt(bottom * top), f"{slope:g}", fontsize=7,
+            va="center", ha="left", color="0.2")
+    ax.text(np.sqrt(x0 * x1), bottom / 10 ** 0.01, "1", fontsize=7, va="top", ha="center",
+            color="0.2")
+    return bottom
 
 
 @styled
 def plot_convergence(path, rows, rates, example_id, ref_n, ref_k, definition="error",
                      title=None):
-    """log-log error against h + k for a journal column: one line per time step, a tick and a
-    label at every level (h + k of every cell), the axes named with their quantities and the
-    error's norms, the fitted slope of all cells drawn (dashed, with its value), the slope in h
-    at the smallest k dotted, and a title naming the problem and the norm."""
+    """log-log error against h + k for a journal column: one line per time step, its measured
+    slope (along the line, in h + k) in the legend; the least-squares fit over all cells
+    (dashed, with its slope); a reference triangle of slope 1 (the schemes' estimates are
+    linear in h + k); a tick at every level with a label where it fits; the error's norms on
+    the y axis; the legend under the axes (never over the data); a title naming the problem
+    and the reference."""
+    import textwrap
     from damage_dolfinx.viz import figstyle
     tk = figstyle.ticker()
-    FixedLocator, NullFormatter, NullLocator = tk.FixedLocator, tk.NullFormatter, tk.NullLocator
     pyplot = figstyle.plt()
     fig, ax = pyplot.subplots(figsize=(COLUMN_WIDTH_IN, PLOT_HEIGHT_IN))
-    ks = sorted({r["k"] for r in rows}, reverse=True)
-    for k in ks:
+    slopes = line_rates(rows)
+    drawn = []
+    for k, slope in slopes.items():
         sel = sorted((r for r in rows if r["k"] == k), key=lambda r: r["h_plus_k"])
-        ax.loglog([r["h_plus_k"] for r in sel], [r["error"] for r in sel], "o-", ms=3.5, lw=1,
-                  label=f"$k$ = {k:g}")
+        x, y = [r["h_plus_k"] for r in sel], [r["error"] for r in sel]
+        ax.loglog(x, y, "o-", ms=3.5, lw=1.1, label=f"$k$ = {k:g}: {_slope_text(slope)}",
+                  zorder=3)
+        drawn.append((x, y))
     hk = np.array([r["h_plus_k"] for r in rows])
     err = np.array([r["error"] for r in rows])
     p = rates["h_plus_k_all"]
     if np.isfinite(p):
         c = np.exp(np.mean(np.log(err) - p * np.log(hk)))
         xs = np.array([hk.min(), hk.max()])
-        ax.loglog(xs, c * xs**p, "k--", lw=1, label=f"fit, all cells: slope {p:.2f}")
-    col = sorted((r for r in rows if r["k"] == min(ks)), key=lambda r: r["h_plus_k"])
-    q = rates.get("h_at_smallest_k", float("nan"))
-    if len(col) > 1 and np.isfinite(q):
-        x = np.array([r["h_plus_k"] for r in col])
-        e = np.array([r["error"] for r in col])
-        c = np.exp(np.mean(np.log(e) - q * np.log(x)))
-        ax.loglog(x, 0.7 * c * x**q, ":", color="0.35", lw=1.2,
-                  label=f"slope in $h$ at $k$ = {min(ks):g}: {q:.2f}")
+        ax.loglog(xs, c * xs**p, "k--", lw=0.9, label=f"fit, all cells: slope {p:.2f}",
+                  zorder=2)
+        drawn.append((xs, c * xs**p))
+    if len(np.unique(hk)) > 1:
+        bottom = _reference_triangle(ax, hk, drawn, REFERENCE_SLOPE)
+        if bottom is not None:
+            ax.plot([], [], color="0.3", lw=0.8, marker="^", ms=4, mfc="0.9", ls="none",
+                    label=f"reference slope {REFERENCE_SLOPE:g}")
+            lo = min(err.min(), bottom)
+            ax.set_ylim(lo / 1.25, err.max() * 1.25)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
     levels = np.unique(np.round(hk, 12))
-    ax.xaxis.set_major_locator(FixedLocator(levels))
-    ax.xaxis.set_minor_locator(NullLocator())
-    ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_xticks(levels)
-    labels, last = [], None
-    for v in levels:  # a tick at every level; a label where it does not overlap the previous
-        show = last is None or np.log10(v / last) > 0.07
-        labels.append(f"{v:.3g}" if show else "")
-        last = v if show else last
-    ax.set_xticklabels(labels, rotation=60, fontsize=7)
-    ax.set_xlabel("mesh size + time step, $h + k$ (length + time units)", fontsize=8)
+    span = np.log10(levels.max() / levels.min()) if len(levels) > 1 else 1.0
+    ax.set_xlim(levels.min() / 10 ** (0.06 * span), levels.max() * 10 ** (0.06 * span))
+    fig.tight_layout()  # the axes' width, for the labels that fit
+    ax.xaxis.set_major_locator(tk.FixedLocator(levels))
+    ax.xaxis.set_minor_locator(tk.NullLocator())
+    ax.xaxis.set_major_formatter(tk.FixedFormatter(_level_labels(levels, ax, 7)))
+    ax.tick_params(axis="x", labelsize=7)
+    ax.set_xlabel("mesh size + time step, $h + k$", fontsize=8)
     norms = figstyle.error_mathtext(definition)
     ax.set_ylabel(f"error {norms}", fontsize=8)
     ax.tick_params(axis="y", labelsize=7)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=6, loc="lower right", framealpha=0.85)
-    figstyle.log_tick_labels(ax)
-    FixedFormatter = tk.FixedFormatter
-    ax.xaxis.set_major_locator(FixedLocator(levels))
-    ax.xaxis.set_major_formatter(FixedFormatter(labels))
-    ax.xaxis.set_minor_formatter(NullFormatter())
     lo, hi = ax.get_ylim()
     if hi / lo < 10:  # less than a decade: a label at every tick of the error axis
-        FuncFormatter, LogLocator = tk.FuncFormatter, tk.LogLocator
-        ax.yaxis.set_minor_locator(LogLocator(subs=np.arange(1, 10)))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
-        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2g}"))
+        ax.yaxis.set_minor_locator(tk.LogLocator(subs=np.arange(1, 10)))
+        ax.yaxis.set_minor_formatter(tk.FuncFormatter(lambda v, _: f"{v:.2g}"))
+        ax.yaxis.set_major_formatter(tk.FuncFormatter(lambda v, _: f"{v:.2g}"))
         ax.tick_params(axis="y", which="minor", labelsize=7)
-    name = title or example_id
-    fig.tight_layout()
-    ax.set_title(f"{name}\nconvergence in {norms}\nreference $n$ = {ref_n}, $k$ = {ref_k:g}",
-                 fontsize=7.5)
+    else:
+        figstyle.log_tick_labels(ax)
+    name = "\n".join(textwrap.wrap(title or example_id, 58))
+    ax.set_title(f"{name}\nreference $n$ = {ref_n}, $k$ = {ref_k:g}", fontsize=7.5)
+    figstyle.legend_below(ax, ncol=2)
+    ax.get_legend().set_title(None)
+    for text in ax.get_legend().get_texts():
+        text.set_fontsize(7)
     figstyle.save_as_laid_out(fig, path)

@@ -277,12 +277,22 @@ def plot_sweep(path, rows, grid, scalar, label):
 
 
 def _plot_sweep(path, rows, grid, scalar, label):
+    """The axes name their quantities (parameter and scalar by what they are, with the
+    symbol of the model's equations and the name to pass to ``--set``); a log x axis when
+    the swept values span a decade or more; one line per combination of the other
+    parameters, named in a legend under the axes (never over the points)."""
     from damage_dolfinx.viz import figstyle
+    from damage_dolfinx.viz.figtext import PARAMETERS, parameter_label, scalar_label
     names = list(grid)
     x_name = next((name for name in names if len(grid[name]) > 1), names[0])
     others = [name for name in names if name != x_name]
-    fig, ax = figstyle.plt().subplots(figsize=(6.4, 4.2))
+    fig, ax = figstyle.plt().subplots(figsize=(5.6, 3.6))
     numeric = all(isinstance(v, (int, float)) for v in grid[x_name])
+
+    def symbol(name):
+        return PARAMETERS[name][1] if name in PARAMETERS else name
+
+    lines = 0
     for combo in itertools.product(*(grid[name] for name in others)):
         sel = [r for r in rows if all(r[name] == v for name, v in zip(others, combo))]
         if not sel:
@@ -290,13 +300,21 @@ def _plot_sweep(path, rows, grid, scalar, label):
         order = grid[x_name]
         sel.sort(key=lambda r: order.index(r[x_name]))
         xs = [r[x_name] if numeric else str(r[x_name]) for r in sel]
-        ax.plot(xs, [r[scalar] for r in sel], "o-", ms=5,
-                label=describe_values(dict(zip(others, combo))) or None)
+        ax.plot(xs, [r[scalar] for r in sel], "o-", ms=5, lw=1.3,
+                label=", ".join(f"{symbol(name)} = {v:g}" if isinstance(v, float)
+                                else f"{symbol(name)} = {v}"
+                                for name, v in zip(others, combo)) or None)
+        lines += 1
     if numeric and min(grid[x_name]) > 0 and max(grid[x_name]) >= 10 * min(grid[x_name]):
         ax.set_xscale("log")
-    ax.set_xlabel(x_name)
-    ax.set_ylabel(scalar)
+    if numeric:
+        ax.set_xticks(sorted(grid[x_name]))  # a tick at every swept value
+        ax.set_xticks([], minor=True)
+        ax.xaxis.set_major_formatter(figstyle.ticker().FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.set_xlabel(parameter_label(x_name))
+    ax.set_ylabel(scalar_label(scalar))
     ax.grid(True, alpha=0.3)
     if others:
-        ax.legend(fontsize=8)
-    figstyle.save(fig, path, title=f"{label}: {scalar} over the sweep")
+        figstyle.legend_below(ax, ncol=min(3, max(1, lines)))
+    figstyle.save(fig, path, title=f"{label}: final {scalar_label(scalar).split('  [')[0]} "
+                                   f"over the sweep ({len(rows)} points)")

@@ -41,13 +41,14 @@ def mathtext(label: str) -> str:
 
 def error_mathtext(definition: str) -> str:
     """A convergence error definition (convergence.py) in mathtext:
-    'max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)' -> max_n (||u - u^hk||_V + ...)."""
+    'max_n (||u - u_hk||_V + ||zeta - zeta_hk||_L2)' -> max_n (‖u - u^hk‖_V + ...), the norms
+    between double bars (``\\Vert``)."""
     greek = {"zeta": r"\zeta", "sigma": r"\sigma", "eta": r"\eta"}
 
     def norm(m):
         x = greek.get(m.group(1), m.group(1))
         space = {"L2": "L^2"}.get(m.group(2), m.group(2))
-        return rf"\|{x} - {x}^{{hk}}\|_{{{space}}}"
+        return rf"\Vert {x} - {x}^{{hk}}\Vert_{{{space}}}"  # (mathtext's \| is a single bar)
     text = re.sub(r"\|\|(\w+) - \1_hk\|\|_(\w+)", norm, definition)
     if text == definition:
         return mathtext(definition)
@@ -86,3 +87,45 @@ def amplification_text(a: float) -> str:
     if a < 1:
         return f"displacements shrunk ×{a:g}"
     return f"displacements ×{a:g}"
+
+
+#: what a model parameter is, for an axis: (description, symbol in mathtext); the names of
+#: docs/models.md ("Common notation" and each model's data)
+PARAMETERS = {
+    "E": ("Young's modulus", "$E$"), "nu": ("Poisson's ratio", r"$\nu_P$"),
+    "kappa": ("damage diffusion", r"$\kappa$"), "zeta_star": ("damage bound", r"$\zeta_*$"),
+    "q_star": ("strain-energy cap", r"$q_*$"), "lam_D": ("healing rate", r"$\lambda_D$"),
+    "lam_u": ("damage rate", r"$\lambda_u$"),
+    "lam_u_plus": ("tension damage rate", r"$\lambda_u^+$"),
+    "lam_u_minus": ("compression damage rate", r"$\lambda_u^-$"),
+    "lam_w": ("damage threshold", r"$\lambda_w$"), "zeta0": ("initial damage", r"$\zeta_0$"),
+    "L_trunc": ("stress truncation", "$L$"), "m_visc": ("viscosity ratio", r"$m_{visc}$"),
+    "g_fric": ("friction bound", "$g$"), "mu_f": ("friction coefficient", r"$\mu_f$"),
+    "c_nu": ("normal compliance", r"$c_\nu$"), "gap": ("initial gap", "$g_0$"),
+    "rho": ("density", r"$\rho$"), "eps_reg": ("friction regularisation", r"$\varepsilon$"),
+}
+
+#: what a final scalar of a run is (sweep.csv, summary.json "final"), for an axis
+SCALARS = {
+    "u_L2": r"$\Vert u\Vert_{L^2}$", "eps_u_L2": r"$\Vert\varepsilon(u)\Vert_{L^2}$",
+    "zeta_min": r"min $\zeta$ (1 = sound)", "zeta_max": r"max $\zeta$ (1 = sound)",
+    "zeta_mean": r"mean $\zeta$ (1 = sound)", "wall_time_s": "wall time [s]",
+    "steps_done": "time steps done", "t_final": "final time $t$",
+}
+
+
+def parameter_label(name: str) -> str:
+    """An axis or legend label for the model parameter ``name``: 'damage diffusion κ
+    (kappa)'; a name of an own model's data stays as it is."""
+    if name not in PARAMETERS:
+        return name
+    what, symbol = PARAMETERS[name]
+    return f"{what} {symbol} ({name})"
+
+
+def scalar_label(name: str) -> str:
+    """An axis label for the final scalar ``name`` of a run: its quantity in mathtext (the
+    contact and friction resultants through :func:`mathtext`), the column's name beside it."""
+    if name in SCALARS:
+        return f"{SCALARS[name]}  [{name}]" if name not in ("wall_time_s",) else SCALARS[name]
+    return name.replace("_", " ") + f"  [{name}]"
