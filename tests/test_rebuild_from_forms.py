@@ -84,8 +84,9 @@ def test_arguments_made_before_and_after_the_first_compile_are_one():
 def test_on_a_bare_space_the_first_compile_changes_the_arguments():
     """What the package's spaces prevent (where the coordinate element is a legacy UFL one)."""
     msh, tags, V = strip("bare")
-    if not legacy_coordinate_element(msh):
-        pytest.skip("basix.ufl coordinate elements: FFCx rewrites nothing")
+    import ffcx
+    if not legacy_coordinate_element(msh) or tuple(int(p) for p in ffcx.__version__.split(".")[:2]) >= (0, 6):
+        pytest.skip("only FFCx 0.5 rewrites the coordinate element at its first compile")
     before = ufl.TestFunction(V)
     compat.form(ufl.dot(before, ufl.as_vector((fresh(), 0.0))) * ufl.dx)
     after = ufl.TestFunction(V)
