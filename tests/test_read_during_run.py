@@ -1,5 +1,5 @@
 """Reading a run while it is written never changes the run: a reader polling read_run every
-0.2 s (and holding fields.h5 open with HDF5's default file locking, as other tools do) during a
+0.05 s (and holding fields.h5 open with HDF5's default file locking, as other tools do) during a
 2-rank run; the run's status and every output equal those of the same run without a reader."""
 import json
 import subprocess
@@ -31,6 +31,7 @@ READER = textwrap.dedent("""
     import h5py
     import damage_dolfinx as dd
     folder, stop, report = Path(sys.argv[1]), Path(sys.argv[2]), Path(sys.argv[3])
+    (report.parent / "reader.ready").touch()  # imports done: the run may start
     polls = reads = fields = held = 0
     errors, seen = [], set()
     while not stop.exists():
@@ -52,7 +53,7 @@ READER = textwrap.dedent("""
                 time.sleep(0.05)
         except OSError:
             pass
-        time.sleep(0.2)
+        time.sleep(0.05)
     report.write_text(json.dumps({"polls": polls, "reads": reads, "field_reads": fields,
                                   "h5_held": held, "errors": errors,
                                   "distinct_time_counts": len(seen)}))
@@ -67,6 +68,10 @@ def test_a_polling_reader_never_changes_a_two_rank_run(tmp_path):
     reader = subprocess.Popen([sys.executable, "-c", READER, str(watched), str(stop),
                                str(report)], env=ENV)
     try:
+        ready, t0 = tmp_path / "reader.ready", time.time()
+        while not ready.exists():  # the reader's own start-up must not eat the run's seconds
+            assert reader.poll() is None and time.time() - t0 < 120, "the reader did not start"
+            time.sleep(0.05)
         t0 = time.time()
         proc = run_cli(ARGS + ["--out", watched], np_=2, check=False)
         seconds = time.time() - t0
