@@ -31,8 +31,8 @@ speed-up and parallel efficiency), ``crossover.md`` (direct against AMG per size
 ``variants.md`` (each run with ``--tag NAME --options '...'``, a solver option set, against the
 untagged run of the same size: time per step, iterations, the answers' difference) from all JSON
 files present, plus ``scaling.png``; and it rewrites the block between the scaling markers of
-benchmarks/README.md (the commands, the exponents and the serial / 2-rank table, copied from
-the records; ``--readme ''`` leaves it alone).
+benchmarks/README.md (the commands and the exponents, copied from the records, and where the
+serial / 2-rank table is; ``--readme ''`` leaves it alone).
 """
 from __future__ import annotations
 
@@ -271,14 +271,14 @@ README_END = "<!-- scaling_2d.py report: end -->"
 
 
 def readme_block(rows, record_name: str) -> list:
-    """The block ``report`` writes into the README: the commands, the exponents and the
-    serial / 2-rank table, each table marked with the record it is copied from."""
+    """The block ``report`` writes into the README: the commands and the exponents (marked
+    with the record they are copied from), and where the serial / 2-rank table is."""
     return (["**Commands** (each size is a separate process, one at a time on the machine; "
              "`runs.json` has each run's own command line):", ""] + commands(rows) + [
              "", f"**Exponents** (`{record_name}/scaling.md`, with every run's full row):", "",
              f"<!-- record: {record_name}/scaling.md -->"] + exponent_table(rows) + [
-             f"**Serial and 2 ranks** (`{record_name}/efficiency.md`):", "",
-             f"<!-- record: {record_name}/efficiency.md -->"] + efficiency_table(rows))
+             f"Time per step serially and on 2 ranks at every size, the speed-up and the first "
+             f"two steps: `{record_name}/efficiency.md`."])
 
 
 def write_readme(readme: Path, block: list) -> bool:
