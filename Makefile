@@ -66,7 +66,7 @@ demo: setup
 	@echo "demo output (XDMF for ParaView, PNG figures, CSV, summary.json) in $(OUT)/demo/"
 
 test: setup
-	$(PY) -m pytest -q -ra tests $(PYTEST_ARGS)
+	$(PY) -m pytest -q -ra --durations=25 tests $(PYTEST_ARGS)
 
 # The documentation site (Sphinx, furo theme, sphinx-gallery executing demos/*.py) into
 # build/docs/html; warnings are errors. DOCS_BUILD and OUT (where `make report` wrote) can move it.
