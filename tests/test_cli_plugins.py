@@ -89,6 +89,26 @@ def test_plugin_file_module_and_model_id(tmp_path):
     assert nomodule.returncode == 2 and "cannot be imported" in nomodule.stderr
 
 
+def test_a_model_id_where_an_example_id_belongs(tmp_path):
+    """A model id is not an example id: the message says which it is and what runs it, for the
+    package's models and for a registered model of one's own without example()."""
+    (tmp_path / "bare_model.py").write_text(textwrap.dedent('''
+        import damage_dolfinx as dd
+
+        @dd.register_model
+        class Bare(dd.model_class("2.1")):
+            id = "bare"
+    '''))
+    own = cli(["run", "bare", "--plugin", "./bare_model.py", "--out", "r"], tmp_path)
+    assert own.returncode == 2 and own.stderr.count("\n") == 1, own.stderr
+    assert "'bare' is a registered model without an example" in own.stderr
+    assert "classmethod example()" in own.stderr
+    package = cli(["show", "2.4-nc"], tmp_path)
+    assert package.returncode == 2 and package.stderr.count("\n") == 1, package.stderr
+    assert "'2.4-nc' is a model id, not an example id" in package.stderr
+    assert not (tmp_path / "r").exists()
+
+
 def test_baselines_plugin_from_the_checkout():
     """The README's command: DAMAGE_DOLFINX_PLUGINS=reproduction.baselines from the checkout."""
     repo = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

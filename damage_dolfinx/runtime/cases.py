@@ -65,6 +65,22 @@ def _model_examples() -> dict:
             if callable(getattr(cls, "example", None))}
 
 
+def _model_hint(name) -> str:
+    """The message for a model id given where an example id is expected ("" when ``name`` is no
+    model id): the package's models run through their catalogue examples, a model of one's own
+    through the Problem its ``example()`` classmethod returns."""
+    from damage_dolfinx.models import registry
+    cls = registry.MODELS.get(name)
+    if cls is None:
+        return ""
+    if cls.__module__.startswith("damage_dolfinx."):
+        return (f"{name!r} is a model id, not an example id: the command line runs examples "
+                f"(`damage-dolfinx list`); a script runs a Problem with model={name!r}")
+    return (f"{name!r} is a registered model without an example: give {cls.__name__} a "
+            "classmethod example() that returns its Problem (docs: Writing a model, "
+            "'Running it'), or run a Problem of it from a script")
+
+
 def _own(name, reading):
     problem = _EXAMPLES.get(name)
     if problem is None:
@@ -94,6 +110,9 @@ def resolve(case, overrides=None):
         if not _SOURCES and not own:
             raise InputError(f"unknown case {case!r}: no catalogue is loaded (import "
                              "damage_dolfinx.catalogue, or give a Problem)")
+        hint = _model_hint(case)
+        if hint:
+            raise UnknownCase(hint)
         extra = f"; registered: {', '.join(own)}" if own else ""
         raise UnknownCase(f"{first}{extra}")
     if hasattr(case, "checked"):
