@@ -7,6 +7,7 @@ import importlib.util
 import inspect
 import sys
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -112,3 +113,22 @@ def test_a_parameter_keeps_the_type_of_its_default():
         with pytest.raises(dd.InputError):
             p.replace(**change)
     assert p.replace(E=2e4, L_trunc=float("inf"), stop_at_zeta_star=False).E == 2e4
+
+
+def test_gather_takes_whole_functions_only():
+    """dd.gather refuses, with one line, what is not a Function (was: a raw AttributeError) and
+    a sub-function (was: DOLFINx's raw RuntimeError); a collapsed component is gathered."""
+    import numpy as np
+    from mpi4py import MPI
+    from dolfinx import fem, mesh
+    import damage_dolfinx as dd
+    m = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
+    u = fem.Function(fem.VectorFunctionSpace(m, ("Lagrange", 1)))
+    u.x.array[:] = np.arange(u.x.array.size)
+    for bad, words in (("results/run", "takes a dolfinx.fem.Function, got str"),
+                       (u.sub(0), "not a sub-function u.sub(i)")):
+        with pytest.raises(dd.InputError, match=re.escape(words)):
+            dd.gather(bad)
+    coords, values = dd.gather(u.sub(0).collapse())
+    whole = dd.gather(u)
+    assert np.array_equal(coords, whole[0]) and np.array_equal(values[:, 0], whole[1][:, 0])

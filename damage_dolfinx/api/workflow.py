@@ -15,6 +15,7 @@ from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from mpi4py import MPI
 
+from damage_dolfinx.core.errors import InputError
 from damage_dolfinx.core.validation import DEFAULTS as _D
 from damage_dolfinx.problem.problem import Problem  # (light: no DOLFINx, for the annotations)
 from damage_dolfinx.runtime.step import CHECKPOINT_SECONDS
@@ -216,8 +217,16 @@ def converge(problem: ProblemLike, out: PathLike, *, n: Optional[Sequence[int]] 
 def gather(function: Any) -> "Optional[tuple[Any, Any]]":
     """``(coords, values)`` of a P1 or DG0 ``dolfinx.fem.Function`` on rank 0, all ranks'
     owned dofs in a rank-independent order (sorted by coordinates), so that a serial run and a
-    parallel one compare entry by entry; ``None`` on the other ranks (collective)."""
+    parallel one compare entry by entry; ``None`` on the other ranks (collective). Anything
+    else, a sub-function ``u.sub(i)`` among them (gather ``u.sub(i).collapse()``), is refused."""
     from damage_dolfinx.runtime.io import gather_dof_field
+    V = getattr(function, "function_space", None)
+    if V is None or not hasattr(function, "x") or not hasattr(V, "tabulate_dof_coordinates"):
+        raise InputError(f"gather takes a dolfinx.fem.Function, got {type(function).__name__}")
+    component = getattr(V, "component", None)
+    if component is not None and len(component()) > 0:
+        raise InputError("gather takes a whole Function, not a sub-function u.sub(i): gather "
+                         "u.sub(i).collapse()")
     return gather_dof_field(function)
 
 
