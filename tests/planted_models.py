@@ -128,6 +128,8 @@ PLANTED = {
     "wrong_prefix": variant("wrong_prefix", mech_prefix="velocity_"),
     "update_names_nothing": variant("update_names_nothing", update=("u", "u_old", "w")),
     "dynamic_without_limit": variant("dynamic_without_limit", dynamic=True),
+    "unknown_norm": variant("unknown_norm", error_components=property(
+        lambda self: [("u", self.u, "H1"), ("zeta", self.zeta, "L2")])),
 }
 
 
@@ -161,6 +163,6 @@ PLANTED.update({
 #: the check of dd.check_model each planted mistake fails
 FAILS = {"nan_in_own_field": "run", "override_drops_field": "contracts",
          "old_state_without_zeta": "contracts", "old_state_without_u": "contracts",
-         "wrong_prefix": "prefixes", "update_names_nothing": "contracts",
+         "wrong_prefix": "prefixes", "update_names_nothing": "contracts", "unknown_norm": "contracts",
          "dynamic_without_limit": "stability_limit", "hidden_old_state": "restart",
          "scalar_without_column": "history_columns", "rank_dependent": "serial_vs_2_ranks"}

@@ -43,6 +43,7 @@ def test_what_the_step_starts_from_is_checkpointed_by_construction(tmp_path):
     ("old_state_without_u", r"add \('u', 'u_old'\) to old_state"),
     ("wrong_prefix", "declares the PETSc prefix 'velocity_', but its solver uses 'mech_'"),
     ("update_names_nothing", "update names 'w'"),
+    ("unknown_norm", "'u' has the norm 'H1'; the norms are V, L2, L2_GammaC"),
 ])
 def test_a_broken_declaration_is_refused_before_any_step(tmp_path, name, message):
     with pytest.raises(ContractError, match=message):

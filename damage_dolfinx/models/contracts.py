@@ -94,6 +94,38 @@ def _solver_prefix(solve):
     return None
 
 
+def _error_component_problems(model) -> list:
+    """What is wrong with ``error_components`` (what a convergence study measures): each a
+    (name, Function, norm) triple, the names distinct, the norm one of ``viz.post.NORMS``; a
+    mistake found here is found before a study's reference run, not after it."""
+    from damage_dolfinx.viz.post import NORMS
+    mid, out, names = model.id, [], set()
+    try:
+        components = list(model.error_components)
+    except TypeError:
+        return [f"model {mid}: error_components is not a list of (name, Function, norm)"]
+    for entry in components:
+        if not (isinstance(entry, (tuple, list)) and len(entry) == 3):
+            out.append(f"model {mid}: error_components holds {entry!r}, not a (name, "
+                       "Function, norm) triple")
+            continue
+        name, f, norm = entry
+        if not isinstance(name, str) or not name or name in names:
+            out.append(f"model {mid}: error_components: the name {name!r} is "
+                       f"{'given twice' if name in names else 'not a non-empty string'}")
+        names.add(name if isinstance(name, str) else None)
+        if not hasattr(getattr(f, "x", None), "array") or not hasattr(f, "function_space"):
+            out.append(f"model {mid}: error_components: {name!r} is a "
+                       f"{type(f).__name__}, not a dolfinx.fem.Function")
+        if norm not in NORMS:
+            out.append(f"model {mid}: error_components: {name!r} has the norm {norm!r}; "
+                       f"the norms are {', '.join(NORMS)}")
+    if not components:
+        out.append(f"model {mid}: error_components is empty: a convergence study would "
+                   "measure nothing")
+    return out
+
+
 def check(model):
     """Raise ContractError naming the first declaration the built ``model`` breaks."""
     found = problems(model)
@@ -125,6 +157,7 @@ def problems(model) -> list:
                     _function(model, name, "update")
                 except ContractError as exc:
                     found.append(("declarations", str(exc)))
+    found += [("declarations", m) for m in _error_component_problems(model)]
     # what the package's blocks read from the previous step is declared
     declared = {(id(a), id(b)) for _, a, b in pairs}
 
