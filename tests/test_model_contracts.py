@@ -68,3 +68,22 @@ def test_a_field_of_its_own_leaving_its_declared_bounds_fails_the_run(tmp_path):
         run(bounded, tmp_path / "bounded")
     assert run(pm.variant("wide", state_bounds={"theta": (0.0, 1.0)}),
                tmp_path / "wide")["status"] == "completed"
+
+
+def test_studies_build_their_models_through_the_same_contracts(tmp_path):
+    """A convergence study's levels and a sweep's points are built where every run's model is
+    (problem/stages.py), so a broken declaration is refused there too, before any step (was: a
+    study built its levels without the check; an unknown norm ended as a raw ValueError)."""
+    for name in ("unknown_norm", "old_state_without_zeta"):
+        problem = pm.problem(pm.PLANTED[name])
+        with pytest.raises(ContractError, match=f"model test-{name}"):
+            dd.converge(problem, str(tmp_path / f"c-{name}"), n=[2, 4], k=[0.05], ref_n=8,
+                        ref_k=0.05, progress=False)
+        assert not list((tmp_path / f"c-{name}").glob("*.csv"))
+    # a sweep's points fail one by one, each with the contract's message and no step done
+    summary = dd.sweep(pm.problem(pm.PLANTED["old_state_without_zeta"]), str(tmp_path / "s"),
+                       {"kappa": [0.5, 1.0]}, progress=False, figures=False)
+    assert summary["status"] == "failed" and summary["point_status"] == {"0": "failed",
+                                                                         "1": "failed"}
+    assert all("add ('zeta', 'zeta_old') to old_state" in m for m in summary["errors"].values())
+    assert not list((tmp_path / "s").glob("point_*/history.csv"))

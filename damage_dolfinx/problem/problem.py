@@ -265,10 +265,12 @@ class Problem:
         return as_geometry(self.mesh(comm, n) if self.family else self.mesh, comm)
 
     def build(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
-              configured=None):
-        """The model of one run on ``comm`` (its mesh built); ``configured``: what
-        :meth:`configure` returned for the same arguments (None: configured here)."""
-        return stages.build(configured or self.configure(n, k, T, h, overrides, mesh_file, comm), comm)
+              configured=None, contracts=True):
+        """The model of one run on ``comm`` (its mesh built, its declarations checked unless
+        ``contracts`` is False); ``configured``: what :meth:`configure` returned for the same
+        arguments (None: configured here)."""
+        return stages.build(configured or self.configure(n, k, T, h, overrides, mesh_file, comm),
+                            comm, contracts)
 
     def problem_data(self, comm, n=None, k=None, T=None, h=None, overrides=None, mesh_file=None,
                      configured=None) -> "Problem":

@@ -94,7 +94,14 @@ def on_mesh(c, comm):
     return built
 
 
-def build(c, comm):
-    """The model of the configured problem ``c`` on ``comm``, built on :func:`on_mesh`."""
+def build(c, comm, contracts=True):
+    """The model of the configured problem ``c`` on ``comm``, built on :func:`on_mesh`, and its
+    declarations checked against what it built (models/contracts.py; a ContractError): every
+    run, study level and sweep point is built here, so none skips the check (``contracts``
+    False: not checked, for dd.check_model, which reports every broken declaration)."""
+    from damage_dolfinx.models.contracts import check
     from damage_dolfinx.models.registry import model
-    return model(c.model)(on_mesh(c, comm))
+    built = model(c.model)(on_mesh(c, comm))
+    if contracts:
+        check(built)
+    return built

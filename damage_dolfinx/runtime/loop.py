@@ -136,7 +136,8 @@ class Run(RunRecords):
         return True
 
     def _build_model(self, mesh_file):
-        """The model, before any step: one that cannot set up its solvers is refused input."""
+        """The model, before any step: one that cannot set up its solvers is refused input (its
+        declarations are checked where every model is built, problem/stages.py)."""
         o = self.options
         try:
             self.stepper = solver_step(
@@ -144,8 +145,6 @@ class Run(RunRecords):
                                       mesh_file, self.configured), "cannot set up the solvers")
         except ConvergenceError as exc:
             raise InputError(str(exc)) from None
-        from damage_dolfinx.models.contracts import check as check_contracts
-        check_contracts(self.stepper)  # its declarations against what it built (ContractError)
         ContactOutput.for_model(self.stepper)  # contact quantities in history.csv and XDMF
 
     def _check_drawable(self):
