@@ -127,3 +127,18 @@ def test_a_plain_loop_on_2_ranks_never_leaves_a_rank_waiting(tmp_path, how):
     else:
         assert proc.returncode != 0
         assert s["status"] == "failed" and "ended on rank(s) 1 at step 2" in s["error"], s
+
+
+def test_a_second_run_into_a_folder_this_process_is_writing_is_refused(tmp_path):
+    """A notebook that runs a cell again while its earlier dd.steps is still open: the second
+    run into that folder is refused, saying the holder is this process, and the first goes on
+    to complete (nothing of it is replaced)."""
+    out = tmp_path / "o"
+    first = dd.steps("2.1-ex1", out, **CASE)
+    it = iter(first)
+    assert [next(it).n, next(it).n] == [0, 1]
+    with pytest.raises(dd.InputError, match="in this same process .a dd.steps not yet closed."):
+        dd.run("2.1-ex1", out, overwrite=True, **CASE)
+    assert [step.n for step in it] == [2, 3, 4]
+    s = summary(out)
+    assert s["status"] == "completed" and s["steps_done"] == 4, s

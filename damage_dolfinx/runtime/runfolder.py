@@ -57,6 +57,10 @@ class RunLock:
             except BlockingIOError:
                 holder = os.read(fd, 1000).decode(errors="replace").split("\n")[0]
                 os.close(fd)
+                if holder.split()[:2] == ["pid", str(os.getpid())]:  # e.g. a notebook's cell
+                    return (f"a run is live in {str(self.path.parent)!r} in this same process "
+                            f"(a dd.steps not yet closed); close it first (run.close(), or "
+                            f"leave its with block)")
                 return f"a run is live in {str(self.path.parent)!r} ({holder or 'see .lock'}); " \
                        f"wait for it to end or stop it (a dead run's lock is released at once)"
             except OSError:  # no flock on this file system: the recorded process must be gone
