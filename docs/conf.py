@@ -160,6 +160,11 @@ def _api_page():
                 directive += f"\n   :exclude-members: {', '.join(shared)}"
         elif inspect.isclass(obj):
             kind, directive = "Classes", f".. autoclass:: damage_dolfinx.{name}\n   :members:"
+            # the members of a base of the package's own that is no public name (Model's
+            # Reporting) are documented with the public class
+            if any(b.__module__.startswith("damage_dolfinx.") and b.__name__ not in names
+                   for b in obj.__mro__[1:]):
+                directive += "\n   :inherited-members:"
         elif inspect.isroutine(obj):
             kind, directive = "Functions", f".. autofunction:: damage_dolfinx.{name}"
         else:
