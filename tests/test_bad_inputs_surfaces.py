@@ -122,8 +122,9 @@ def test_gather_takes_whole_functions_only():
     from mpi4py import MPI
     from dolfinx import fem, mesh
     import damage_dolfinx as dd
+    from damage_dolfinx.compat.spaces import vector_p1
     m = mesh.create_unit_square(MPI.COMM_WORLD, 4, 4)
-    u = fem.Function(fem.VectorFunctionSpace(m, ("Lagrange", 1)))
+    u = fem.Function(vector_p1(m))
     u.x.array[:] = np.arange(u.x.array.size)
     for bad, words in (("results/run", "takes a dolfinx.fem.Function, got str"),
                        (u.sub(0), "not a sub-function u.sub(i)")):
