@@ -110,10 +110,13 @@ def _error_component_problems(model) -> list:
                        "Function, norm) triple")
             continue
         name, f, norm = entry
-        if not isinstance(name, str) or not name or name in names:
-            out.append(f"model {mid}: error_components: the name {name!r} is "
-                       f"{'given twice' if name in names else 'not a non-empty string'}")
-        names.add(name if isinstance(name, str) else None)
+        if not (isinstance(name, str) and name):
+            out.append(f"model {mid}: error_components: the name {name!r} is not a non-empty "
+                       "string")
+        elif name in names:
+            out.append(f"model {mid}: error_components: the name {name!r} is given twice")
+        else:
+            names.add(name)
         if not hasattr(getattr(f, "x", None), "array") or not hasattr(f, "function_space"):
             out.append(f"model {mid}: error_components: {name!r} is a "
                        f"{type(f).__name__}, not a dolfinx.fem.Function")
