@@ -80,18 +80,3 @@ def test_a_constant_bound_that_changes_is_evaluated_again():
     solver.solve()
     assert solver.nodes.bound_refreshes == 1
     assert abs(solver.nodes.g - 2.0).max() < 1e-12
-
-
-def test_a_matrix_assembled_once_may_not_hold_the_state():
-    import ufl
-    from dolfinx import fem
-    from mpi4py import MPI
-    from damage_dolfinx import blocks as b
-    geometry = DEMO["block"](MPI.COMM_WORLD, 1)
-    Z = b.scalar_p1(geometry.mesh)
-    zeta = fem.Function(Z, name="zeta")
-    u, w = ufl.TrialFunction(Z), ufl.TestFunction(Z)
-    with pytest.raises(dd.InputError, match="holds the Function"):
-        b.LinearSolver((1 + zeta) * u * w * ufl.dx, w * ufl.dx, [], "test_", b.SolveContext(),
-                       constant_matrix=True)
-    b.LinearSolver((1 + zeta) * u * w * ufl.dx, w * ufl.dx, [], "test_", b.SolveContext())

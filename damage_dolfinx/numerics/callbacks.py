@@ -8,6 +8,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
+from damage_dolfinx.numerics.held_data import AssembledFrom
 
 
 def form_callbacks(F, J, u, bcs, jacobian_split=None):
@@ -76,11 +77,16 @@ def _split_jacobian(full_jacobian, J_form, J_constant, J_varying, A, bcs, u):
     compat.assemble_matrix(K, compat.form(J_constant), bcs)
     K.assemble()
     varying = compat.form(J_varying)
+    constant_data = AssembledFrom(J_constant, K.getComm().tompi4py())  # its Constants
 
     def jacobian(x, A):
         if not A.isAssembled():  # a new matrix (e.g. a lagged preconditioner): its pattern
             full_jacobian(x, A)
             return
+        if constant_data.changed():  # a Constant of J_constant changed: K anew
+            K.zeroEntries()
+            compat.assemble_matrix(K, compat.form(J_constant), bcs)
+            K.assemble()
         K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         compat.assemble_matrix(A, varying, bcs)
         A.assemble()

@@ -16,6 +16,7 @@ from petsc4py import PETSc
 from damage_dolfinx import compat
 from damage_dolfinx.forms.constitutive import Psi_q, eta_star, split_norms_sq
 from damage_dolfinx.forms.damage import damage_step_forms
+from damage_dolfinx.numerics.held_data import AssembledFrom
 from damage_dolfinx.numerics.obstacle import CHOLESKY_MAX_DOFS, ObstacleFastPath, fast_path_options
 from damage_dolfinx.numerics.solvers import (DIRECT, ConvergenceError, LinearSolver, SNESSolver, SolveContext,
                       serial_cholesky)
@@ -71,7 +72,8 @@ class DamageStep:
 
     ``zeta`` receives the new damage; ``zeta_old`` and ``phi_old`` (a UFL expression of the
     step n-1 state) enter the right-hand side. The matrix b is constant for a fixed k: it is
-    assembled (and, for the PDE form, factorised) once.
+    assembled (and, for the PDE form, factorised) once, and again before a solve when a
+    Function or Constant in it (a ``kappa`` or ``k`` of the model's own) has changed.
     """
 
     def __init__(self, zeta: fem.Function, zeta_old: fem.Function, phi_old, k, kappa,
@@ -99,6 +101,7 @@ class DamageStep:
         self.A = compat.create_matrix(self.a)
         compat.assemble_matrix(self.A, self.a, [])
         self.A.assemble()
+        self._a_data = AssembledFrom(a, V.mesh.comm)  # assembled again when it changes
         self.b = compat.create_vector(self.L)
         self.lower, self.upper = self.b.duplicate(), self.b.duplicate()
         self.lower.set(zeta_star if obstacle else PETSc.NINFINITY)
@@ -113,8 +116,10 @@ class DamageStep:
         self.lu_retries = 0
         # The SNES's first iteration with cached linear algebra (obstacle.py);
         # -<prefix>vi_fast 0 restores the SNES alone, bit for bit
-        self.fast = ObstacleFastPath(self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
-                                     CHOLESKY_MAX_DOFS[V.mesh.topology.dim]) \
+        self._new_fast_path = lambda: ObstacleFastPath(
+            self.A, zeta_star, 1.0, self.snes.snes.getKSP(), solver,
+            CHOLESKY_MAX_DOFS[V.mesh.topology.dim])
+        self.fast = self._new_fast_path() \
             if enabled and obstacle and not irreversible else None  # scalar bounds only
         self._atol_set, self._rtol, self._vecs = None, None, None
         self._parallel = V.mesh.comm.size > 1
@@ -155,6 +160,12 @@ class DamageStep:
             return self.linear.solve(self.zeta)
         if self.irreversible:  # the upper bound is zeta_{n-1}
             compat.petsc_vec(self.zeta_old).copy(self.upper)
+        if self._a_data.changed():  # (collective) a datum of b changed: b and its solvers anew
+            self.A.zeroEntries()
+            compat.assemble_matrix(self.A, self.a, [])
+            self.A.assemble()
+            if self.fast is not None:
+                self.fast = self._new_fast_path()
         with self.b.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(self.b, self.L)

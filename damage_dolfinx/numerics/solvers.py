@@ -17,6 +17,7 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.callbacks import form_callbacks, relative_change
+from damage_dolfinx.numerics.held_data import AssembledFrom
 
 
 from damage_dolfinx.core.errors import ConvergenceError  # noqa: F401
@@ -132,33 +133,20 @@ def lagged_direct(comm) -> dict:
     return serial_cholesky(comm, LAGGED_DIRECT)
 
 
-def _refuse_frozen(form, prefix, what):
-    """A matrix assembled once may not hold Functions (the state): it would be frozen at their
-    values when the solver is built (InputError, before any step)."""
-    import ufl
-    from dolfinx import fem
-    from damage_dolfinx.core.parameters import InputError
-    if not isinstance(form, ufl.Form):
-        return
-    held = [c for c in form.coefficients() if isinstance(c, fem.Function)]
-    if held:
-        raise InputError(f"the matrix of the {prefix!r} solver is assembled once ({what}) but "
-                         f"holds the Function(s) {', '.join(sorted({f.name for f in held}))}: "
-                         "it would stay at their values when the solver was built; pass "
-                         "constant_matrix=False (assembled at every solve)")
-
-
 class LinearSolver:
     """Solve a(u, w) = L(w) with Dirichlet conditions by a PETSc KSP.
 
-    With ``constant_matrix=True`` the matrix is assembled and factorised once. Otherwise it is
-    re-assembled in place each solve (same sparsity); with ``refactor_after_its`` set and a
+    With ``constant_matrix=True`` the matrix is assembled and factorised once, and again only
+    when a Function or Constant of ``a`` has changed since (:mod:`held_data`: a datum of the
+    state is never held at its value when the solver was built). Otherwise it is re-assembled
+    in place each solve (same sparsity); with ``refactor_after_its`` set and a
     Krylov KSP (default options LAGGED_DIRECT) the preconditioner (an exact factorisation of an
     earlier matrix) is kept until the iteration count exceeds that number, and rebuilt at once
     if the lagged solve fails.
 
     ``rhs_product=(r, f)`` (r a bilinear form, f a Function) adds R f to the right-hand side,
-    R the matrix of r assembled once (no boundary conditions): a term r(f, w) of the linear
+    R the matrix of r assembled once (no boundary conditions; again when a Function or Constant
+    of r has changed): a term r(f, w) of the linear
     form taken out of L, e.g. the inertia (rho v_{n-1}/k, w) as M v_{n-1}/k (one sparse product
     instead of a quadrature loop and its coefficient packing at every assembly). When every
     Dirichlet value is zero (checked at each assembly) the lifting is skipped: it would
@@ -171,24 +159,23 @@ class LinearSolver:
 
     def __init__(self, a, L, bcs, prefix: str, context: SolveContext, constant_matrix=False,
                  defaults=None, refactor_after_its=None, rhs_product=None, block_matrix=False):
-        if constant_matrix:
-            _refuse_frozen(a, prefix, "constant_matrix=True")
-        if rhs_product is not None:
-            _refuse_frozen(rhs_product[0], prefix, "rhs_product")
         self.a, self.L, self.bcs = compat.form(a), compat.form(L), list(bcs)
         self._product = None
         if rhs_product is not None:
             r, f = rhs_product
-            R = compat.create_matrix(compat.form(r))
-            compat.assemble_matrix(R, compat.form(r), [])
-            R.assemble()
+            self._r = compat.form(r)
+            R = compat.create_matrix(self._r)
             self._product = (R, compat.petsc_vec(f))
+            self._r_data = AssembledFrom(r, R.getComm().tompi4py())
+            self._assemble_product()
         self.prefix, self.context, self.constant_matrix = prefix, context, constant_matrix
         set_default_options(prefix, DIRECT if defaults is None else defaults)
         self.b = compat.create_vector(self.L)
         blocked = block_matrix and self.b.getComm().getSize() == 1 and _petsc_lu(prefix)
         self.A = compat.create_matrix(self.a, "baij" if blocked else None)
         self._assembled = False
+        #: what a constant matrix was assembled from (assembled again when it changes)
+        self._a_data = AssembledFrom(a, self.A.getComm().tompi4py()) if constant_matrix else None
         self.ksp = PETSc.KSP().create(self.A.getComm())
         self.ksp.setOptionsPrefix(prefix)
         self.ksp.setOperators(self.A)
@@ -210,8 +197,16 @@ class LinearSolver:
         self._assembled = True
         self.timings["assemble_matrix"] += time.perf_counter() - start
 
+    def _assemble_product(self):
+        R = self._product[0]
+        R.zeroEntries()
+        compat.assemble_matrix(R, self._r, [])
+        R.assemble()
+
     def assemble_rhs(self):
         start = time.perf_counter()
+        if self._product is not None and self._r_data.changed():
+            self._assemble_product()
         with self.b.localForm() as bl:
             bl.set(0.0)
         compat.assemble_vector(self.b, self.L)
@@ -226,7 +221,8 @@ class LinearSolver:
 
     def solve(self, u):
         """Solve into the Function ``u``; returns the KSP iteration count."""
-        if not (self.constant_matrix and self._assembled):
+        changed = self._a_data.changed() if self.constant_matrix else True  # (collective)
+        if changed or not self._assembled:
             self.assemble_matrix()
         self.assemble_rhs()
         x = compat.petsc_vec(u)

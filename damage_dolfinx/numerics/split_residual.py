@@ -3,7 +3,8 @@ affine in u with fixed coefficients (2.3's (2.137)):
 
     F(u; w) = F_cell(u; w) + r(u; w),   F_cell(x) = F_cell(x_0) + K (x - x_0),
 
-K = dF_cell/du (no Function in it: assembled once, Dirichlet rows of the identity), r the
+K = dF_cell/du (no Function in it: assembled once, and again when a Constant in it
+changed; Dirichlet rows of the identity), r the
 other integrals (the Gamma_C contact term and the traction: a boundary assembly). At the start
 of a solve (:meth:`SplitResidual.begin`) the residual is assembled once at the starting point
 x_0 as :func:`callbacks.form_callbacks` assembles it, F(x_0), with r(x_0); every evaluation is
@@ -32,6 +33,7 @@ from petsc4py import PETSc
 
 from damage_dolfinx import compat
 from damage_dolfinx.numerics.callbacks import constant_cell_jacobian
+from damage_dolfinx.numerics.held_data import AssembledFrom
 
 #: largest relative difference to the assembled residual accepted by the set-up check
 CHECK_RTOL = 1e-12
@@ -58,10 +60,10 @@ class SplitResidual:
         J_cell, F_rest, J_rest = split
         self.u, self.bcs = u, list(bcs)
         self.u_vec = compat.petsc_vec(u)
-        a = compat.form(J_cell)
-        self.K = compat.create_matrix(a)
-        compat.assemble_matrix(self.K, a, self.bcs)  # Dirichlet rows: identity
-        self.K.assemble()
+        self._K_form = compat.form(J_cell)
+        self.K = compat.create_matrix(self._K_form)
+        self._assemble_K()
+        self._K_data = AssembledFrom(J_cell, self.K.getComm().tompi4py())  # its Constants
         self.rest_form = compat.form(F_rest)
         self.F0 = compat.create_vector(self.rest_form)
         self.r0, self.x0, self.dx = self.F0.duplicate(), self.F0.duplicate(), self.F0.duplicate()
@@ -75,8 +77,16 @@ class SplitResidual:
         if probe.norm() != 0.0:
             raise ValueError("SplitResidual: Dirichlet values must be zero")
 
+    def _assemble_K(self):
+        self.K.zeroEntries()
+        compat.assemble_matrix(self.K, self._K_form, self.bcs)  # Dirichlet rows: identity
+        self.K.assemble()
+
     def begin(self):
-        """F(x_0) and r(x_0) at the starting point x_0 = u of this solve."""
+        """F(x_0) and r(x_0) at the starting point x_0 = u of this solve (K assembled again
+        first if a Constant in it has changed)."""
+        if self._K_data.changed():
+            self._assemble_K()
         self.u_vec.copy(self.x0)
         self.form_residual(self.x0, self.F0)
         self._assemble_rest(self.r0)

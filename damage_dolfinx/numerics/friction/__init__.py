@@ -65,6 +65,9 @@ def _newton(problem, eps_reg, rho_uzawa, omega_pd, tol):
     return RegularisedNewton(problem, eps_reg)
 
 
+_newton.assembles_operator_of_state = True  # an operator a of the state: see RegularisedNewton
+
+
 #: the friction solvers by name: factory(problem, eps_reg, rho_uzawa, omega_pd, tol); Newton on
 #: the regularised law is the library's; others are registered (the reproduction's baselines)
 SOLVERS = {"newton": _newton}
@@ -74,7 +77,10 @@ _NEEDS_CLAMP = set()
 
 def register_solver(name: str, factory, needs_clamp: bool = False):
     """Make ``factory(problem, eps_reg, rho_uzawa, omega_pd, tol)`` the friction solver
-    ``name`` (the parameter ``friction_solver``); ``needs_clamp``: refused without Gamma_D."""
+    ``name`` (the parameter ``friction_solver``); ``needs_clamp``: refused without Gamma_D. A
+    problem whose operator a holds Functions is refused for it unless the factory has the
+    attribute ``assembles_operator_of_state = True`` (it then assembles a where a can have
+    changed)."""
     SOLVERS[name] = factory
     if needs_clamp:
         _NEEDS_CLAMP.add(name)
@@ -135,6 +141,13 @@ def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: 
         raise InputError(f"unknown friction solver {kind!r}; choose one of {', '.join(SOLVERS)}"
                          " (the reproduction's uzawa and penalty-duality are registered by "
                          "importing reproduction.baselines from the checkout)")
+    from damage_dolfinx.numerics.held_data import held
+    functions, _ = held(problem.a)
+    if functions and not getattr(SOLVERS[kind], "assembles_operator_of_state", False):
+        raise InputError(f"the {kind} friction solver keeps the matrix of the operator a from one "
+                         "solve to the next, and a holds the Function(s) "
+                         f"{', '.join(sorted({f.name for f in functions}))}: it would stay at "
+                         "their values when the solver was built; use the newton solver")
     solver = SOLVERS[kind](problem, eps_reg, rho_uzawa, omega_pd, tol)
     nodes = getattr(solver, "nodes", None)
     if hasattr(nodes, "refresh_bound") and not getattr(solver, "refreshes_bound", False):

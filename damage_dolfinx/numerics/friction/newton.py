@@ -12,6 +12,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from damage_dolfinx import compat
+from damage_dolfinx.numerics.held_data import AssembledFrom, held
 from damage_dolfinx.numerics.condensed import BlockUpdateSolver, DiagonalUpdatePC
 from damage_dolfinx.forms.contact import F_reg, F_reg_vector, Phi_reg, Phi_reg_vector
 from damage_dolfinx.numerics.solvers import (NEWTON, ConvergenceError, NonlinearSolver, replace_default_option,
@@ -50,7 +51,14 @@ FRICTION_NEWTON = {**NEWTON, "snes_linesearch_type": "bt", "snes_max_it": 100,
 
 class RegularisedNewton:
     """Newton on the regularised optimality equation (2.99)-(2.101):
-    a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9)."""
+    a(v, w) + sum_i m_i Phi_eps(v_tau,i) w_tau,i = l(w), eps = eps_reg (thesis 1e-9).
+
+    An operator ``a`` that holds Functions (of the state) is assembled, with the residual and
+    the Jacobian, at every Newton iteration; otherwise its matrix is kept (the algebraic
+    residual, the active-set iteration, the condensed Jacobian)."""
+
+    #: an ``a`` holding Functions is assembled where it can have changed (make_solver checks)
+    assembles_operator_of_state = True
 
     name = "newton"
     #: its solve evaluates a bound of the state itself (make_solver wraps other solvers)
@@ -88,13 +96,21 @@ class RegularisedNewton:
                   + friction_change * ds)
         self._energy = compat.form(energy)
         self.residual = AlgebraicResidual(problem, self.nodes, self.eps)
+        # an operator a of the state (Functions in it, e.g. a damage-dependent viscosity or an
+        # implicit contact stiffness): a, hence the residual and the Jacobian, assembled at
+        # every Newton iteration (the algebraic residual, the active-set iteration and the
+        # condensed Jacobian all keep the matrix of a from one solve to the next)
+        a_functions, _ = held(problem.a)
+        self.operator_of_state = bool(a_functions)
+        self._a_constants = AssembledFrom(problem.a, msh.comm, functions=False)
         self.newton = NonlinearSolver(F, v, problem.bcs, prefix, problem.context,
                                       defaults={**FRICTION_NEWTON, **newton_linear(problem.V)},
                                       refactor_after_its=REFACTOR_ITS, J=J,
-                                      jacobian_key=self._stick_set, residual=self.residual)
+                                      jacobian_key=None if self.operator_of_state
+                                      else self._stick_set, residual=self.residual)
         # the assembled residual where the nodal one is not exact (a bent Gamma_C)
         self.algebraic = True
-        if not self.residual.matches(self.newton.form_residual):
+        if self.operator_of_state or not self.residual.matches(self.newton.form_residual):
             self.use_form_residual()
         pdas = PrimalDualActiveSet(self.residual, prefix + "pdas_") if self.algebraic else None
         self.pdas = pdas if pdas is not None and pdas.usable else None
@@ -337,6 +353,12 @@ class RegularisedNewton:
         before = self.snes.iterations + self.pdas_iterations
         self.eps.value = self.target
         self.nodes.refresh_bound()  # a bound of the state: evaluated now (nodes.py)
+        if self.algebraic and self._a_constants.changed():
+            raise ConvergenceError(
+                f"the friction problem's operator a holds {self._a_constants.names}, whose value "
+                "changed after its solver was built, and this solver keeps the matrix of a from "
+                "one solve to the next: give such a datum as a Function (the solver then "
+                "assembles a at every iteration) or build the friction solver again")
         if self.algebraic:
             self.residual.assemble_rhs()
         try:
