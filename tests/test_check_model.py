@@ -64,3 +64,40 @@ def test_serial_against_two_ranks(tmp_path):
         problem = runpy.run_path(str(script))["problem"]
         report = dd.check_model(problem, tmp_path / name, script=script)
         assert report["serial_vs_2_ranks"].status == status, str(report)
+
+
+@pytest.mark.parametrize("given, message", [
+    (dict(steps=0), "steps must be a whole number >= 2, got 0"),
+    (dict(steps=2.5), "steps must be a whole number >= 2"),
+    (dict(n=-1), "n must be a whole number >= 1, got -1"),
+    (dict(mpi="yes"), "mpi must be True or False"),
+    (dict(out=__file__), "is a file, not a folder"),
+    (dict(script="/nonexistent/model.py"), "is not a file"),
+    (dict(name=""), "name must be a non-empty text"),
+])
+def test_bad_arguments_are_refused_before_any_work(given, message, tmp_path, monkeypatch):
+    import damage_dolfinx.api.model_check as mc
+    monkeypatch.setattr(mc, "_case_for", lambda model: pytest.fail("work began"))
+    with pytest.raises(dd.InputError, match=message):
+        dd.check_model(pm.problem(pm.Compliant), **given)
+
+
+def test_what_to_check_is_named_when_it_is_not_a_model():
+    with pytest.raises(dd.InputError, match="check_model takes a Problem, a catalogue case name"):
+        dd.check_model(42)
+
+
+def test_a_model_id_is_its_class():
+    from damage_dolfinx.api.model_check import _model_of_id
+    assert _model_of_id("3.1") is dd.model_class("3.1")
+    assert _model_of_id("3.1-ex1") == "3.1-ex1"
+
+
+def test_a_folder_of_the_users_in_out_is_refused_untouched(tmp_path):
+    mine = tmp_path / "whole"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("mine")
+    with pytest.raises(dd.InputError, match="did not write"):
+        dd.check_model(pm.problem(pm.Compliant), out=tmp_path, mpi=False)
+    assert (mine / "notes.txt").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["whole"]

@@ -88,6 +88,10 @@ def _case_for(model):
     """A Problem, a case name, or a Model class -> what a run takes (a package model's class:
     its first catalogue example; an own class: its ``check_problem()`` classmethod)."""
     from damage_dolfinx.models.base import Model
+    if not (isinstance(model, str) or hasattr(model, "checked") or isinstance(model, type)
+            and issubclass(model, Model)):
+        raise InputError("check_model takes a Problem, a catalogue case name, a model id or a "
+                         f"Model class, got {type(model).__name__}")
     if isinstance(model, type) and issubclass(model, Model):
         if hasattr(model, "check_problem"):
             return model.check_problem()
@@ -98,6 +102,37 @@ def _case_for(model):
                 return case.id
         raise InputError(f"check_model: give a Problem with model {model.id} (or define its "
                          "classmethod check_problem())")
+    return model
+
+
+#: the run folders check_model writes in its ``out``
+RUN_FOLDERS = ("whole", "restarted", "two_ranks")
+
+
+def _check_arguments(out, steps, n, mpi, script, name, comm):
+    """check_model's arguments, before any work (one InputError naming the first bad one)."""
+    from damage_dolfinx.core import validation
+    validation.arguments(n=n, comm=comm)
+    validation.whole("steps", steps, low=2)  # (a restart half-way needs two steps)
+    validation.flag("mpi", mpi)
+    validation.text("name", name)
+    if out is not None:
+        validation.path("out", out)
+        if Path(out).exists() and not Path(out).is_dir():
+            raise InputError(f"out {str(out)!r} is a file, not a folder")
+    if script is not None:
+        validation.path("script", script)
+        if not Path(script).is_file():
+            raise InputError(f"script {str(script)!r} is not a file (give the file that "
+                             "defines the problem, e.g. script=__file__)")
+
+
+def _model_of_id(model):
+    """A registered model's id (e.g. '3.1') as its class; anything else unchanged."""
+    if isinstance(model, str):
+        from damage_dolfinx.models import registry
+        if model in registry.MODELS:
+            return registry.model(model)
     return model
 
 
@@ -125,7 +160,7 @@ def check_model(model, out=None, steps=4, n=None, mpi=True, script=None, name="p
     """Check a model in ``steps`` steps on a small mesh (level ``n``; None: the problem's).
 
     ``model``: a :class:`~damage_dolfinx.Problem` with the model, a catalogue case name, or a
-    Model class (a package model: its first catalogue example). ``out``: the folder of the runs
+    Model class or a registered model's id (a package model: its first catalogue example). ``out``: the folder of the runs
     (None: a temporary one, removed after). ``mpi``: also compare with 2 ranks where mpirun is
     available; a Problem written in a script is made again there from ``script`` (the file;
     its variable ``name``), a case name as it is. Returns a :class:`ModelCheck` (printed on
@@ -134,7 +169,8 @@ def check_model(model, out=None, steps=4, n=None, mpi=True, script=None, name="p
     from damage_dolfinx.runtime.cases import resolve
     from damage_dolfinx.runtime.runner import ColumnError, run
     from damage_dolfinx.numerics.solvers import ConvergenceError
-    case = _case_for(model)
+    _check_arguments(out, steps, n, mpi, script, name, comm)
+    case = _case_for(_model_of_id(model))
     if isinstance(case, str):
         import damage_dolfinx.catalogue  # noqa: F401 (registers the case names)
     problem = resolve(case)
@@ -142,6 +178,10 @@ def check_model(model, out=None, steps=4, n=None, mpi=True, script=None, name="p
     if temporary:
         out = Path(comm.bcast(tempfile.mkdtemp(prefix="check_model_") if comm.rank == 0 else None))
     out = Path(out)
+    if not temporary:  # its run folders, before any work: nothing of the user's is touched
+        from damage_dolfinx.runtime.runfolder import claim_folder
+        for sub in RUN_FOLDERS:
+            claim_folder(out / sub, "run", set(), False, True, comm, apply=False)
     report = ModelCheck(str(getattr(problem, "id", case)))
     add = lambda *a: report.checks.append(Check(*a))  # noqa: E731
     try:
