@@ -87,3 +87,43 @@ def test_studies_build_their_models_through_the_same_contracts(tmp_path):
                                                                          "1": "failed"}
     assert all("add ('zeta', 'zeta_old') to old_state" in m for m in summary["errors"].values())
     assert not list((tmp_path / "s").glob("point_*/history.csv"))
+
+
+#: declarations of the wrong form or naming no Function: refused before the model is built
+#: (were raw ValueError/AttributeError/TypeError from inside the constructor or the first
+#: checkpoint, a bound silently ignored, or a name read letter by letter)
+MALFORMED = {
+    "old_state_not_pairs": (dict(old_state="u"), "old_state is 'u', not a tuple of"),
+    "old_state_triple": (dict(old_state=(("u", "u_old", "v"), ("zeta", "zeta_old"))),
+                         r"old_state holds \('u', 'u_old', 'v'\), not a \(Function, copy\) pair"),
+    "old_state_self": (dict(old_state=(("u", "u"), ("zeta", "zeta_old"), ("theta", "theta_old"))),
+                       "old_state pairs 'u' with itself"),
+    "old_state_other_space": (dict(old_state=(("u", "zeta_old"), ("zeta", "u_old"),
+                                              ("theta", "theta_old"))),
+                              "a Function of another space"),
+    "update_two_names": (dict(update=("u", "u_old")), "update is .*not None or \\(new, old, rate\\)"),
+    "checkpoint_fields_text": (dict(checkpoint_fields="u"), "checkpoint_fields is 'u', not a tuple"),
+    "checkpoint_fields_unknown": (dict(checkpoint_fields=("u", "zeta", "v", "nope")),
+                                  "checkpoint_fields names 'nope', which is not set"),
+    "history_columns_text": (dict(history_columns="theta_max"), "history_columns is 'theta_max'"),
+    "state_bounds_unknown": (dict(state_bounds={"k": (0.0, 1.0)}), "state_bounds names 'k'"),
+    "state_bounds_reversed": (dict(state_bounds={"theta": (1.0, 0.0)}), "lo <= hi"),
+    "state_bounds_nan": (dict(state_bounds={"theta": (float("nan"), 1.0)}), "lo <= hi"),
+    "state_bounds_number": (dict(state_bounds={"theta": 0.5}), "not a pair of numbers"),
+    "state_bounds_list": (dict(state_bounds=[("theta", (0.0, 1.0))]), "not a dict"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MALFORMED))
+def test_a_malformed_declaration_is_refused_before_the_model_is_built(tmp_path, name):
+    attrs, message = MALFORMED[name]
+    with pytest.raises(ContractError, match=message):
+        run(pm.variant(name, **attrs), tmp_path / name)
+    assert not (tmp_path / name / "history.csv").exists()
+
+
+def test_check_model_reports_a_malformed_declaration():
+    report = dd.check_model(pm.problem(pm.variant("bounds", state_bounds={"theta": 0.5})),
+                            mpi=False)
+    assert report.failed() == ["contracts"], str(report)
+    assert "not a pair of numbers" in report["contracts"].detail

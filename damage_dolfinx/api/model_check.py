@@ -190,6 +190,14 @@ def check_model(model, out=None, steps=4, n=None, mpi=True, script=None, name="p
         T = steps * k
         n_run = configured.n
         configured = problem.configure(n_run, k, T, None, None, None, comm)
+        from damage_dolfinx.models.registry import model as model_of
+        wrong = contracts.declaration_problems(model_of(configured.model))
+        if wrong:  # the form of a declaration: the model is not built
+            add("contracts", "fail", wrong[0], "change the declaration the message names")
+            for name_ in ("prefixes", "stability_limit", "run", "finite", "history_columns",
+                          "restart", "serial_vs_2_ranks"):
+                add(name_, "skipped", "not run: the model is refused before it is built")
+            return report
         from damage_dolfinx.numerics.stability_bound import exact_estimates
         with exact_estimates():  # the eigensolved limit, not only a cheap bound below it
             stepper = problem.build(comm, n_run, k, T, configured=configured, contracts=False)

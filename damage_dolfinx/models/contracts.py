@@ -1,7 +1,10 @@
 """The contracts between a model's declarations and what it builds, checked when the model is
 built (before any step), for the package's models and for a model of your own alike.
 
-* every name of ``old_state`` and ``update`` is a Function of the built model;
+* the declarations have their form (name pairs, name tuples, bounds lo <= hi), checked on
+  the class before it is built (:func:`declaration_problems`);
+* every name of ``old_state``, ``update``, ``checkpoint_fields`` and ``state_bounds`` is a
+  Function of the built model, each ``old_state`` pair two Functions of one space;
 * what a step reads from the previous one is in the checkpoint: each Function ``new`` of an
   ``old_state`` pair (its value at the end of step n is what step n+1 starts from) is among
   :meth:`Model.checkpoint_state` (the base class adds it by construction; a model that
@@ -38,6 +41,59 @@ def _function(model, name, what):
                             f"{'not set' if f is None else 'not a dolfinx Function'} on the "
                             "built model (create it in __init__)")
     return f
+
+
+def _names(value) -> bool:
+    """A tuple or list of non-empty strings (a bare string is not: it would be read letter by
+    letter)."""
+    return isinstance(value, (tuple, list)) and all(isinstance(v, str) and v for v in value)
+
+
+def declaration_problems(model) -> list:
+    """What is wrong with the form of the declarations of ``model`` (a Model class before it is
+    built, or a built model): ``old_state`` (name pairs), ``update`` (None or three names),
+    ``checkpoint_fields`` and ``history_columns`` (tuples of names), ``state_bounds`` ({name:
+    (lo, hi)}, lo <= hi, no NaN). Checked before the model is built, so that a mistake there
+    is named, not met as an error inside the constructor."""
+    mid, out = getattr(model, "id", "?"), []
+    old_state = getattr(model, "old_state", ())
+    if not isinstance(old_state, (tuple, list)):
+        out.append(f"model {mid}: old_state is {old_state!r}, not a tuple of (Function, copy) "
+                   "pairs of attribute names, e.g. (('u', 'u_old'), ('zeta', 'zeta_old'))")
+    else:
+        for pair in old_state:
+            if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and _names(pair)):
+                out.append(f"model {mid}: old_state holds {pair!r}, not a (Function, copy) pair "
+                           "of attribute names, e.g. ('u', 'u_old')")
+            elif pair[0] == pair[1]:
+                out.append(f"model {mid}: old_state pairs {pair[0]!r} with itself: the copy "
+                           "must be a Function of its own, e.g. "
+                           f"({pair[0]!r}, {pair[0] + '_old'!r})")
+    update = getattr(model, "update", None)
+    if update is not None and not (isinstance(update, (tuple, list)) and len(update) == 3
+                                   and _names(update)):
+        out.append(f"model {mid}: update is {update!r}, not None or (new, old, rate) attribute "
+                   "names, e.g. ('u', 'u_old', 'v')")
+    for what in ("checkpoint_fields", "history_columns"):
+        value = getattr(model, what, ())
+        if not _names(value):
+            out.append(f"model {mid}: {what} is {value!r}, not a tuple of names, e.g. "
+                       f"({value!r},)" if isinstance(value, str) else
+                       f"model {mid}: {what} is {value!r}, not a tuple of names")
+    bounds = getattr(model, "state_bounds", None) or {}
+    if not isinstance(bounds, dict):
+        out.append(f"model {mid}: state_bounds is {bounds!r}, not a dict {{attribute: (lo, hi)}}")
+        return out
+    for name, pair in bounds.items():
+        ok = (isinstance(name, str) and isinstance(pair, (tuple, list)) and len(pair) == 2
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in pair))
+        if not ok:
+            out.append(f"model {mid}: state_bounds[{name!r}] is {pair!r}, not a pair of numbers "
+                       "(lo, hi), e.g. (0.0, 1.0) (-inf or inf: no bound)")
+        elif any(math.isnan(v) for v in pair) or pair[0] > pair[1]:
+            out.append(f"model {mid}: state_bounds[{name!r}] is {tuple(pair)!r}: lo <= hi, "
+                       "neither NaN, are needed")
+    return out
 
 
 def checkpoint_functions(model) -> dict:
@@ -139,27 +195,41 @@ def check(model):
 def problems(model) -> list:
     """(check, message) for each declaration the built ``model`` breaks, check one of
     ``declarations``, ``previous_state``, ``checkpoint``, ``prefixes``, ``stability_limit``."""
-    mid, found = model.id, []
+    mid = model.id
+    found = [("declarations", m) for m in declaration_problems(model)]
+    if found:
+        return found
     pairs = []
     for pair in model.old_state:
-        if not (isinstance(pair, tuple) and len(pair) == 2):
-            found.append(("declarations", f"model {mid}: old_state holds {pair!r}, not a "
-                          "(Function, copy) pair of attribute names"))
-            continue
         try:
-            pairs.append((pair[0], *(_function(model, name, "old_state") for name in pair)))
+            new, old = (_function(model, name, "old_state") for name in pair)
         except ContractError as exc:
             found.append(("declarations", str(exc)))
-    if model.update is not None:
-        if len(model.update) != 3:
-            found.append(("declarations", f"model {mid}: update is {model.update!r}, not "
-                          "(new, old, rate)"))
-        else:
-            for name in model.update:
-                try:
-                    _function(model, name, "update")
-                except ContractError as exc:
-                    found.append(("declarations", str(exc)))
+            continue
+        if new.x.array.shape != old.x.array.shape or new is old:
+            found.append(("declarations", f"model {mid}: old_state pairs {pair[0]!r} with "
+                          f"{pair[1]!r}, {'the same Function' if new is old else 'a Function of another space'}: "
+                          "the copy must be a Function of its own on the same space"))
+            continue
+        pairs.append((pair[0], new, old))
+    for name in model.update or ():
+        try:
+            _function(model, name, "update")
+        except ContractError as exc:
+            found.append(("declarations", str(exc)))
+    if getattr(model, "checkpoint_supported", True):
+        for name in model.checkpoint_fields:
+            try:
+                _function(model, name, "checkpoint_fields")
+            except ContractError as exc:
+                found.append(("declarations", str(exc)))
+    for name in model.state_bounds or {}:
+        try:
+            _function(model, name, "state_bounds")
+        except ContractError as exc:
+            found.append(("declarations", str(exc)))
+    if found:  # a name that is no Function: the checks below would meet it as an error
+        return found
     found += [("declarations", m) for m in _error_component_problems(model)]
     # what the package's blocks read from the previous step is declared
     declared = {(id(a), id(b)) for _, a, b in pairs}

@@ -99,9 +99,13 @@ def build(c, comm, contracts=True):
     declarations checked against what it built (models/contracts.py; a ContractError): every
     run, study level and sweep point is built here, so none skips the check (``contracts``
     False: not checked, for dd.check_model, which reports every broken declaration)."""
-    from damage_dolfinx.models.contracts import check
+    from damage_dolfinx.models.contracts import ContractError, check, declaration_problems
     from damage_dolfinx.models.registry import model
-    built = model(c.model)(on_mesh(c, comm))
+    cls = model(c.model)
+    wrong = declaration_problems(cls) if contracts else []
+    if wrong:  # the form of a declaration, before the constructor meets it
+        raise ContractError(wrong[0])
+    built = cls(on_mesh(c, comm))
     if contracts:
         check(built)
     return built
