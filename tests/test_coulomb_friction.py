@@ -80,3 +80,21 @@ def test_a_constant_bound_that_changes_is_evaluated_again():
     solver.solve()
     assert solver.nodes.bound_refreshes == 1
     assert abs(solver.nodes.g - 2.0).max() < 1e-12
+
+
+@pytest.mark.parametrize("value, message", [(-1.0, "negative"), (float("nan"), "not finite"),
+                                            (float("inf"), "not finite")])
+def test_a_bound_that_is_no_friction_bound_is_refused(value, message):
+    from dolfinx import fem
+    with pytest.raises(dd.InputError, match=f"friction bound g is {message}.*when the friction "
+                                            "solver is built"):
+        _friction(lambda msh: fem.Constant(msh, value))
+
+
+def test_a_bound_that_turns_negative_stops_the_solve():
+    from dolfinx import fem
+    g, solver = _friction(lambda msh: fem.Constant(msh, 0.5))
+    solver.solve()
+    g.value = -0.5          # e.g. mu p_nu(u) with a negative mu once contact begins
+    with pytest.raises(dd.ConvergenceError, match="negative at a contact node at the start"):
+        solver.solve()

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from mpi4py import MPI
 import ufl
 from dolfinx import fem
 from petsc4py import PETSc
@@ -121,6 +122,7 @@ class ContactNodes:
             raise RuntimeError("scalar and vector P1 dof numberings differ")  # never seen
         self.m = m[self.dofs]
         self.g = gm[self.dofs] / self.m
+        self._check_bound(problem.msh.comm, InputError, "when the friction solver is built")
         return w, ds, n_owned
 
     def _bound_setup(self, problem, phi, ds, n_owned):
@@ -156,9 +158,30 @@ class ContactNodes:
             return False  # (a bytes comparison: under a microsecond per Constant)
         gm = _assembled(self._g_form)[:self._n_owned]
         self.g[:] = gm[self.dofs] / self.m
+        from damage_dolfinx.core.errors import ConvergenceError
+        self._check_bound(self._comm, ConvergenceError, "at the start of a friction solve")
         self._g_values = [np.asarray(c.value).tobytes() for c in self._g_constants]
         self.bound_refreshes += 1
         return True
+
+    def _check_bound(self, comm, error, when):
+        """The bound at the contact nodes is finite and >= 0 (a negative one would push the
+        slip on instead of resisting it), on every rank alike; ``error`` raised otherwise."""
+        self._comm = comm
+        g = self.g
+        finite = bool(np.isfinite(g).all())
+        values = np.array([g.min() if g.size and finite else np.inf,
+                           -np.abs(g).max() if g.size and finite else 0.0, 0.0 if finite else -1.0])
+        if comm.size > 1:  # one reduction: min g, max |g|, any node not finite
+            comm.Allreduce(MPI.IN_PLACE, values, op=MPI.MIN)
+        low, largest, finite = values[0], -values[1], values[2] == 0.0
+        if not finite:
+            raise error(f"the friction bound g is not finite (NaN or Inf) at a contact node "
+                        f"{when}: its data (mu, c_nu, the state it is written from) overflow")
+        if low < -1e-12 * max(1.0, largest):
+            raise error(f"the friction bound g is negative at a contact node {when} (min "
+                        f"{low:.6g}): a friction bound is >= 0 (e.g. mu >= 0 and c_nu >= 0 in "
+                        "mu p_nu(u))")
 
     @property
     def dim(self) -> int:
