@@ -137,3 +137,17 @@ def test_a_friction_solver_that_keeps_its_operator_refuses_one_of_the_state():
             b.friction_solver("keeps-a", problem, 1e-9, 1.0, 100.0)
     finally:
         del friction.SOLVERS["keeps-a"]
+
+
+@pytest.mark.parametrize("given, message", [
+    (dict(rho=0.0), "rho must be > 0"), (dict(rho=-1.0), "rho must be > 0"),
+    (dict(E=-1.0), "E must be > 0"), (dict(nu=0.6), "nu must be < 0.5"),
+    (dict(m_visc=0.0), "m_visc must be > 0"), (dict(E=float("nan")), "E must be a finite"),
+    (dict(c_nu=-5.0), "c_nu must be >= 0"),
+])
+def test_a_stability_estimate_of_impossible_data_is_refused(given, message):
+    # were a PETSc error code, a ZeroDivisionError, a C compile error (E = nan) or a number
+    msh, _ = _block()
+    data = {"E": 1.0, "nu": 0.3, "rho": 1.0, "m_visc": 1.0, **given}
+    with pytest.raises(dd.InputError, match=message):
+        b.estimate_k_max(b.vector_p1(msh), **data)

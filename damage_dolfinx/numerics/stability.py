@@ -291,6 +291,24 @@ def stiffness_and_mass(V, E, nu, rho, c_nu=0.0, dsC=None, bcs=(), normal=None):
     return K_B, K, M
 
 
+def _checked_data(E, nu, rho, m_visc, c_nu):
+    """The data of a stability estimate as floats (a Constant by its value), checked: a
+    density or viscosity of zero or below, or a Poisson ratio outside (-1, 1/2), has no
+    stable time step to estimate (the eigenproblem would fail in PETSc or divide by zero)."""
+    from damage_dolfinx.core.validation import real
+
+    def value(v):
+        return float(np.asarray(v.value)) if hasattr(v, "value") else v
+    E, nu, rho, m_visc, c_nu = (value(v) for v in (E, nu, rho, m_visc, c_nu))
+    out = [real("E", E, low=0.0, low_open=True), real("nu", nu, low=-1.0, low_open=True),
+           real("rho", rho, low=0.0, low_open=True), real("m_visc", m_visc, low=0.0,
+                                                          low_open=True),
+           real("c_nu", c_nu, low=0.0)]
+    if not out[1] < 0.5:
+        raise InputError(f"nu must be < 0.5 (Poisson's ratio), got {out[1]:g}")
+    return out
+
+
 def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal=None,
                        method="auto", k=None) -> dict:
     """omega^2_max of (K_B + K_c, M) and the time-step limit k_max of the scheme (module
@@ -303,7 +321,9 @@ def estimate_stability(V, E, nu, rho, m_visc, c_nu=0.0, dsC=None, bcs=(), normal
     stability_bound.exact_estimates() the eigensolve runs all the same). Otherwise the
     eigensolved k_max, kept in memory and on disk (stability_cache.py) by a hash of the
     matrices, m_visc and the eigen method (``decided_by``: ``eigensolve``, ``cache`` (this
-    process) or ``disk cache`` (an earlier process))."""
+    process) or ``disk cache`` (an earlier process)). The data are checked first (InputError:
+    E, rho, m_visc > 0, -1 < nu < 1/2, c_nu >= 0, all finite)."""
+    E, nu, rho, m_visc, c_nu = _checked_data(E, nu, rho, m_visc, c_nu)
     K_B, K, M = stiffness_and_mass(V, E, nu, rho, c_nu, dsC, bcs, normal)
     try:
         rstart, rend = K.getOwnershipRange()
