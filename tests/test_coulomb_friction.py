@@ -98,3 +98,25 @@ def test_a_bound_that_turns_negative_stops_the_solve():
     g.value = -0.5          # e.g. mu p_nu(u) with a negative mu once contact begins
     with pytest.raises(dd.ConvergenceError, match="negative at a contact node at the start"):
         solver.solve()
+
+
+def test_a_time_step_above_the_models_mesh_limit_is_refused(tmp_path, capsys):
+    # a dynamic model of one's own gives its limit through mesh_k_max(); the run compares k with
+    # it once the model is built (was: k = 1.6 k_max ran and 'completed')
+    k_max = DEMO["problem"](4.0, T=0.05).k_max()
+    with pytest.raises(dd.InputError, match="exceeds the stability limit .*mesh_k_max"):
+        dd.run(DEMO["problem"](4.0, T=0.1, k=0.05), tmp_path / "big", progress=False,
+               figures=False)
+    assert 0.05 > k_max
+    import dataclasses
+    allowed = dataclasses.replace(DEMO["problem"](4.0, T=0.1, k=0.05), allow_unstable=True)
+    assert dd.run(allowed, tmp_path / "allowed", progress=False,
+                  figures=False)["status"] == "completed"
+    assert "WARNING: time step k = 0.05 exceeds the stability limit" in capsys.readouterr().err
+
+
+def test_a_dynamic_model_without_its_limit_is_refused(tmp_path):
+    import planted_models as pm
+    with pytest.raises(dd.InputError, match="implement mesh_k_max"):
+        dd.run(pm.problem(pm.PLANTED["dynamic_without_limit"]), tmp_path / "none",
+               progress=False, figures=False)

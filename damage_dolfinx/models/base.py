@@ -90,6 +90,10 @@ class Model(Reporting):
     dynamic: bool = False
     #: what limits k ("" when nothing does)
     stability_limit: str = ""
+    #: True: the model compares k with its mesh-dependent limit itself (the package's dynamic
+    #: models, by their datum stability_check); otherwise the run compares k with
+    #: :meth:`mesh_k_max` once the model is built
+    checks_time_step: bool = False
     #: the Functions (attribute names) a checkpoint holds, in order
     checkpoint_fields: tuple = ("u", "zeta")
     #: the scalars this model adds to history.csv

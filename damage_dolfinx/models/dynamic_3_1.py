@@ -64,6 +64,7 @@ class DynamicKelvinVoigt(NormalComplianceScalars, Model):
     title = "dynamic Kelvin-Voigt body, normal compliance"
     contact_roles = ("normal_compliance",)
     dynamic = True
+    checks_time_step = True  # k against its eigenvalue estimate (stability_check)
     stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("v_L2", "u_max", "penetration_rms")

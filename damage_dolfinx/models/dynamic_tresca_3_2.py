@@ -49,6 +49,7 @@ class DynamicTresca(Model):
     title = "dynamic Kelvin-Voigt body, bilateral contact with Tresca friction"
     contact_roles = ("tresca",)
     dynamic = True
+    checks_time_step = True  # k against its eigenvalue estimate (stability_check)
     stability_limit = "explicit elastic force (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("friction_its",)  # + u_tau_max_<face> per contact face

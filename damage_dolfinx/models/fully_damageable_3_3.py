@@ -84,6 +84,7 @@ class FullyDamageableContact(Model):
     title = "dynamic fully damageable body, normal compliance"
     contact_roles = ("normal_compliance",)
     dynamic = True
+    checks_time_step = True  # k against its eigenvalue estimate (stability_check)
     stability_limit = "explicit elastic and contact forces (eigenvalue estimate)"
     checkpoint_fields = ("u", "zeta", "v")
     history_columns = ("v_L2",)  # + the contact monitor's and the probe's columns

@@ -108,4 +108,22 @@ def build(c, comm, contracts=True):
     built = cls(on_mesh(c, comm))
     if contracts:
         check(built)
+        _check_mesh_limit(c, built)
     return built
+
+
+def _check_mesh_limit(c, built):
+    """A dynamic model's time step against its mesh-dependent limit (Model.mesh_k_max, checked
+    by the contracts: a dynamic model that does not give it is refused), refused above it
+    unless the problem allows an unstable step (then a warning), like a closed-form limit in
+    :func:`configure`; a model that checks its own (``checks_time_step``) is left to it."""
+    if not built.dynamic or built.checks_time_step:
+        return
+    from damage_dolfinx.models.contracts import mesh_k_max
+    from damage_dolfinx.numerics.stability import check_time_step
+    limit = mesh_k_max(built)
+    k = float(c.k)
+    if k > limit:
+        action = c.params.extra.get("stability_check") or \
+            ("warn" if c.allow_unstable else "error")
+        check_time_step(k, limit, f"{c.id}: mesh_k_max() of model {built.id}", action=action)
