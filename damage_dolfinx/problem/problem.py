@@ -251,7 +251,7 @@ class Problem:
         """The problem as one run has it (validated data, T, k, the mesh level and file), or
         InputError. ``overrides`` may name the reading (key ``reading``). ``comm``: the ranks of
         the run (default all), which the memory check is collective on."""
-        ex, overrides = self._resolved(overrides)
+        ex, overrides = self.checked()._resolved(overrides)  # (as a run checks it)
         return stages.configure(ex, n, k, T, h, overrides, mesh_file, comm)
 
     def default_k(self, n, h, T, params) -> float:

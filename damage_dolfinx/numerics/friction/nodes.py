@@ -156,8 +156,14 @@ class ContactNodes:
         if not self.variable_bound and all(np.asarray(c.value).tobytes() == v for c, v in
                                            zip(self._g_constants, self._g_values)):
             return False  # (a bytes comparison: under a microsecond per Constant)
-        gm = _assembled(self._g_form)[:self._n_owned]
-        self.g[:] = gm[self.dofs] / self.m
+        b = getattr(self, "_g_vec", None)
+        if b is None:  # made once: the bound is assembled into it at every refresh
+            b = self._g_vec = compat.create_vector(self._g_form)
+        with b.localForm() as bl:
+            bl.set(0.0)
+        compat.assemble_vector(b, self._g_form)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+        self.g[:] = b.getArray(readonly=True)[self.dofs] / self.m  # owned entries
         from damage_dolfinx.core.errors import ConvergenceError
         self._check_bound(self._comm, ConvergenceError, "at the start of a friction solve")
         self._g_values = [np.asarray(c.value).tobytes() for c in self._g_constants]
