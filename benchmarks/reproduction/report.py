@@ -26,6 +26,11 @@ p = argparse.ArgumentParser()
 p.add_argument("--results", default="results")
 p.add_argument("--pdf", action="store_true", help="also print REPORT.pdf with headless Chromium")
 a = p.parse_args()
+_made = [name for name in ("figures", "figures-quick", "convergence", "convergence-quick")
+         if (Path(a.results) / name / "index.json").is_file()]
+if not _made:  # a report of no results would judge nothing: refused, nothing written
+    p.error(f"{a.results!r} holds no results of make figures, figures-quick or convergence "
+            "(their index.json): run one of them first, or give --results the folder they wrote")
 page = report.build(a.results)
 counts = re.search(r"\*\*(of \d+ thesis .*?)\*\*", page.with_suffix(".md").read_text())
 print(f"report: {page.parent}/ (REPORT.html, REPORT.md, images/)"

@@ -93,6 +93,9 @@ if __name__ == "__main__":
     p.add_argument("--out", type=Path)
     p.add_argument("--json", type=Path)
     a = p.parse_args()
+    for given in (a.before, a.after):
+        if not given.is_file():
+            p.error(f"{str(given)!r} is not a file (give two REPORT.md files)")
     d = compare(summary(a.before.read_text()), summary(a.after.read_text()))
     text = markdown(d)
     if a.out:
