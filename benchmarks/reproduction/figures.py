@@ -134,6 +134,19 @@ p.add_argument("--resume", action="store_true",
 a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/figures-quick" if a.quick else "results/figures"))
+if a.np < 1:
+    p.error(f"--np must be a whole number >= 1, got {a.np}")
+if out.exists() and not out.is_dir():
+    p.error(f"--out {str(out)!r} is a file, not a folder")
+if a.only:
+    known = {job.example for job in reproduce.figure_jobs(mode, None)}
+    unknown = sorted(set(a.only) - known)
+    if unknown:
+        p.error(f"--only: no figure run of {', '.join(unknown)}; the examples with figures: "
+                f"{', '.join(sorted(known))}")
+if (a.restyle or a.settings) and not (out / "index.json").is_file():
+    p.error(f"--restyle and --settings redraw the figures of an earlier build: {str(out)!r} "
+            "holds none (no index.json)")
 if a.settings:
     import json
     print(f"redrawn: {' '.join(reproduce.redraw_settings(mode, out))}; meshes named: "
