@@ -29,6 +29,16 @@ p.add_argument("--reading", choices=("literal", "evidence"),
 a = p.parse_args()
 mode = "quick" if a.quick else "full"
 out = Path(a.out or ("results/convergence-quick" if a.quick else "results/convergence"))
+if a.np < 1:
+    p.error(f"--np must be a whole number >= 1, got {a.np}")
+if out.exists() and not out.is_dir():
+    p.error(f"--out {str(out)!r} is a file, not a folder")
+if a.only:
+    known = {job.example for job in reproduce.convergence_jobs(mode, a.reading)}
+    unknown = sorted(set(a.only) - known)
+    if unknown:
+        p.error(f"--only: no convergence study of {', '.join(unknown)}; the studies: "
+                f"{', '.join(sorted(known))}")
 index = reproduce.run_convergence(mode, out, a.np, a.only, a.resume, a.reading)
 for s in index["studies"]:
     rate = s.get("rates", {}).get("h_plus_k_all")
