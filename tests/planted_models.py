@@ -133,19 +133,6 @@ PLANTED = {
 }
 
 
-class _PrefixThroughAMethod(Compliant):
-    """Its mech sub-step calls a method of the model (whose solver is not looked into) and
-    declares a prefix none of its solvers has."""
-
-    def scheme(self):
-        steps = list(super().scheme())
-        steps[-1] = dd.SubStep("mech", "semismooth", "velocity_", self._mech, ("mech_its",))
-        return tuple(steps)
-
-    def _mech(self):
-        return self.mech.solve()
-
-
 class _HiddenOldState(Compliant):
     """Reads theta_old, copied by itself (begin_step) and not declared: its checkpoint misses
     theta, which no declaration shows (the restart check sees it)."""
@@ -166,9 +153,6 @@ class _RankDependent(Compliant):
 
 
 PLANTED.update({
-    "prefix_through_a_method": type("prefix_through_a_method", (_PrefixThroughAMethod,),
-                                    {"id": "test-prefix_through_a_method",
-                                     "__module__": __name__}),
     "hidden_old_state": type("hidden_old_state", (_HiddenOldState,),
                              {"id": "test-hidden_old_state", "__module__": __name__}),
     "scalar_without_column": variant("scalar_without_column", history_columns=()),
@@ -179,7 +163,6 @@ PLANTED.update({
 #: the check of dd.check_model each planted mistake fails
 FAILS = {"nan_in_own_field": "run", "override_drops_field": "contracts",
          "old_state_without_zeta": "contracts", "old_state_without_u": "contracts",
-         "wrong_prefix": "prefixes", "prefix_through_a_method": "prefixes",
-         "update_names_nothing": "contracts", "unknown_norm": "contracts",
+         "wrong_prefix": "prefixes", "update_names_nothing": "contracts", "unknown_norm": "contracts",
          "dynamic_without_limit": "stability_limit", "hidden_old_state": "restart",
          "scalar_without_column": "history_columns", "rank_dependent": "serial_vs_2_ranks"}

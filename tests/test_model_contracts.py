@@ -42,7 +42,6 @@ def test_what_the_step_starts_from_is_checkpointed_by_construction(tmp_path):
     ("old_state_without_zeta", r"add \('zeta', 'zeta_old'\) to old_state"),
     ("old_state_without_u", r"add \('u', 'u_old'\) to old_state"),
     ("wrong_prefix", "declares the PETSc prefix 'velocity_', but its solver uses 'mech_'"),
-    ("prefix_through_a_method", "'velocity_', which none of the model's solvers uses"),
     ("update_names_nothing", "update names 'w'"),
     ("unknown_norm", "'u' has the norm 'H1'; the norms are V, L2, L2_GammaC"),
 ])

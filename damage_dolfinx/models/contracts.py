@@ -13,8 +13,7 @@ built (before any step), for the package's models and for a model of your own al
   ``previous_state`` (the damage step: (zeta, zeta_old), and (u, u_old) for the explicit
   source of ``obstacle_damage_step``) needs each of its (new, old) pairs in ``old_state``;
 * the PETSc prefix of each :class:`SubStep` is that of the solver its ``solve`` calls, where
-  the solver can be seen (a bound ``solve`` of a package solver, or a ``partial`` of one), and
-  otherwise (a method of the model) the prefix of one of the solvers the model holds;
+  the solver can be seen (a bound ``solve`` of a package solver, or a ``partial`` of one);
 * a dynamic model gives its mesh-dependent stability limit through :meth:`Model.mesh_k_max`
   (a positive number, or None: none).
 
@@ -151,24 +150,6 @@ def _solver_prefix(solve):
     return None
 
 
-def _held_prefixes(model) -> set:
-    """The PETSc prefixes of the solvers the model holds as attributes (a package solver, or
-    the SNES or KSP it holds, one level down)."""
-    from petsc4py import PETSc
-    out = set()
-    for value in list(vars(model).values()):
-        for holder in (value, getattr(value, "snes", None), getattr(value, "linear", None),
-                       getattr(value, "newton", None), getattr(value, "ksp", None)):
-            if isinstance(holder, (PETSc.KSP, PETSc.SNES)):
-                out.add(holder.getOptionsPrefix() or "")
-                continue
-            prefix = getattr(holder, "prefix", None)
-            if isinstance(prefix, str) and prefix:
-                out.add(prefix)
-    out.discard("")
-    return out
-
-
 def _error_component_problems(model) -> list:
     """What is wrong with ``error_components`` (what a convergence study measures): each a
     (name, Function, norm) triple, the names distinct, the norm one of ``viz.post.NORMS``; a
@@ -274,9 +255,7 @@ def problems(model) -> list:
                               f"(old_state) but its checkpoint ({', '.join(saved) or 'nothing'}) "
                               f"does not hold it: a restart would start from a wrong {name!r}; "
                               "add it to checkpoint_fields or to what checkpoint_state() returns"))
-    # the declared prefix of each sub-step is its solver's (where its solve is a method of the
-    # model, a prefix that none of the model's solvers uses)
-    held = _held_prefixes(model)
+    # the declared prefix of each sub-step is its solver's
     for step in model.scheme():
         if step.solve is None:
             continue
@@ -286,12 +265,6 @@ def problems(model) -> list:
                           f"model {mid}: sub-step {step.name!r} declares the PETSc prefix "
                           f"{step.prefix!r}, but its solver uses {used!r} (-{step.prefix}... "
                           f"options would not reach it): declare prefix={used!r}"))
-        elif used is None and step.prefix and held and step.prefix not in held:
-            found.append(("prefixes",
-                          f"model {mid}: sub-step {step.name!r} declares the PETSc prefix "
-                          f"{step.prefix!r}, which none of the model's solvers uses (theirs: "
-                          f"{', '.join(sorted(held))}): -{step.prefix}... options would reach "
-                          "nothing; declare the prefix of the solver the sub-step calls"))
     # the mesh-dependent stability limit, where the model gives it
     if model.dynamic and type(model).mesh_k_max is not _base_mesh_k_max():
         try:
