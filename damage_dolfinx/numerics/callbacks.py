@@ -74,7 +74,8 @@ def _split_jacobian(full_jacobian, J_form, J_constant, J_varying, A, bcs, u):
     K = compat.create_matrix(J_form)
     full_jacobian(None, K)  # the pattern of an assembled J, the one A gets below
     K.zeroEntries()
-    compat.assemble_matrix(K, compat.form(J_constant), bcs)
+    constant = compat.form(J_constant)
+    compat.assemble_matrix(K, constant, bcs)
     K.assemble()
     varying = compat.form(J_varying)
     constant_data = AssembledFrom(J_constant, K.getComm().tompi4py())  # its Constants
@@ -85,7 +86,7 @@ def _split_jacobian(full_jacobian, J_form, J_constant, J_varying, A, bcs, u):
             return
         if constant_data.changed():  # a Constant of J_constant changed: K anew
             K.zeroEntries()
-            compat.assemble_matrix(K, compat.form(J_constant), bcs)
+            compat.assemble_matrix(K, constant, bcs)
             K.assemble()
         K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         compat.assemble_matrix(A, varying, bcs)

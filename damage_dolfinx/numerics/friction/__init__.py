@@ -158,9 +158,7 @@ def make_solver(kind: str, problem: FrictionProblem, eps_reg: float, rho_uzawa: 
             return solve(*args, **kwargs)
         solver.solve = solve_with_current_bound
     elif nodes is None:
-        from ufl.algorithms.analysis import extract_coefficients
-        from dolfinx import fem
-        if any(isinstance(c, fem.Function) for c in extract_coefficients(problem.g)):
+        if held(problem.g)[0]:
             raise InputError(f"the {kind} friction solver cannot evaluate a friction bound that "
                              "depends on the state (it holds no contact nodes to update): use "
                              "the newton solver")

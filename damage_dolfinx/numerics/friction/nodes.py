@@ -132,9 +132,9 @@ class ContactNodes:
         have changed (:meth:`refresh_bound`: Functions in it, or a Constant whose value
         changed). A bound of the friction unknown itself is refused: the solvers hold g fixed
         during a solve (their Jacobian has no dg/dv)."""
-        from ufl.algorithms.analysis import extract_coefficients, extract_type
+        from damage_dolfinx.numerics.held_data import AssembledFrom, held
         g = problem.g
-        functions = [c for c in extract_coefficients(g) if isinstance(c, fem.Function)]
+        functions, _ = held(g)
         if any(f is problem.v for f in functions):
             raise InputError("the friction bound g depends on the friction unknown "
                              f"{problem.v.name!r} itself: the friction solvers hold g fixed "
@@ -142,8 +142,7 @@ class ContactNodes:
                              "mu p_nu(u_old), blocks.coulomb_friction_bound)")
         self._g_form = compat.form(g * phi * ds)
         self._g_functions = functions
-        self._g_constants = [c for c in extract_type(g, ufl.Constant) if hasattr(c, "value")]
-        self._g_values = [np.asarray(c.value).tobytes() for c in self._g_constants]
+        self._g_constants = AssembledFrom(g, problem.msh.comm, functions=False)
         self._n_owned = n_owned
         #: True: g is refreshed before every solve (it holds Functions)
         self.variable_bound = bool(functions)
@@ -153,9 +152,9 @@ class ContactNodes:
         """Evaluate g at the nodes again (in place: every solver sees the new g) if it can have
         changed since the last evaluation; True if it was evaluated. A bound of x and fixed
         Constants (the thesis models) is never evaluated again."""
-        if not self.variable_bound and all(np.asarray(c.value).tobytes() == v for c, v in
-                                           zip(self._g_constants, self._g_values)):
-            return False  # (a bytes comparison: under a microsecond per Constant)
+        constants_changed = self._g_constants.changed()  # (bytes: under a us per Constant)
+        if not self.variable_bound and not constants_changed:
+            return False
         b = getattr(self, "_g_vec", None)
         if b is None:  # made once: the bound is assembled into it at every refresh
             b = self._g_vec = compat.create_vector(self._g_form)
@@ -166,7 +165,6 @@ class ContactNodes:
         self.g[:] = b.getArray(readonly=True)[self.dofs] / self.m  # owned entries
         from damage_dolfinx.core.errors import ConvergenceError
         self._check_bound(self._comm, ConvergenceError, "at the start of a friction solve")
-        self._g_values = [np.asarray(c.value).tobytes() for c in self._g_constants]
         self.bound_refreshes += 1
         return True
 
